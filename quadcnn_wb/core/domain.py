@@ -1,0 +1,316 @@
+"""The region to mesh: an outer loop and hole loops of exact curves, validated.
+
+Everything downstream assumes what this module guarantees, so every way an input can be
+wrong is refused here with a message that names the loop and segment at fault:
+outer loop counter-clockwise, holes clockwise (the domain always lies to the left),
+loops closed exactly, no curve meets another except where consecutive curves join,
+every hole strictly inside the outer loop and outside the other holes, positive area.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .curves import Arc, Line, curve_bbox, loop_signed_area, winding_number
+from .intersections import Overlap, curve_intersections
+
+CLOSE_TOL = 1e-9  # relative to the domain size, as DESIGN.md states for loop closure
+CAD_SUFFIXES = {".step", ".stp", ".brep", ".brp", ".iges", ".igs"}
+
+
+class DomainError(ValueError):
+    """Bad input geometry; the message says what is wrong and where."""
+
+
+@dataclass(frozen=True)
+class Domain:
+    loops: tuple  # tuple of tuples of curves; loops[0] outer (CCW), the rest holes (CW)
+    units: str = "mm"
+    bbox_min: np.ndarray = field(default=None, compare=False)
+    bbox_max: np.ndarray = field(default=None, compare=False)
+
+    @property
+    def size(self) -> float:
+        """Diagonal of the bounding box: the scale all tolerances are relative to."""
+        return float(np.hypot(*(self.bbox_max - self.bbox_min)))
+
+    @property
+    def center(self) -> np.ndarray:
+        return 0.5 * (self.bbox_min + self.bbox_max)
+
+    @property
+    def holes(self) -> int:
+        return len(self.loops) - 1
+
+    @property
+    def area(self) -> float:
+        return float(sum(loop_signed_area(loop) for loop in self.loops))
+
+    @property
+    def perimeter(self) -> float:
+        return float(sum(c.length for loop in self.loops for c in loop))
+
+    def curves(self):
+        """(loop index, segment index, curve) for every boundary curve."""
+        for li, loop in enumerate(self.loops):
+            for si, curve in enumerate(loop):
+                yield li, si, curve
+
+    def to_json(self) -> dict:
+        return {"units": self.units,
+                "loops": [[c.to_json() for c in loop] for loop in self.loops]}
+
+
+def load_domain(path) -> Domain:
+    """Domain from a Domain JSON v1 file or a STEP/BREP/IGES file (first planar face)."""
+    path = Path(path)
+    if path.suffix.lower() in CAD_SUFFIXES:
+        from .cad_import import read_cad_face
+
+        return read_cad_face(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DomainError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DomainError(f"{path}: cannot read: {exc}") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DomainError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno}, "
+                          f"column {exc.colno})") from None
+    return domain_from_json(data)
+
+
+def domain_from_json(data) -> Domain:
+    """Parse and validate a Domain JSON v1 object (already decoded)."""
+    if not isinstance(data, dict):
+        raise DomainError("domain JSON must be an object with a 'loops' list")
+    units = data.get("units", "mm")
+    if not isinstance(units, str):
+        raise DomainError("'units' must be a string")
+    loops = data.get("loops")
+    if not isinstance(loops, list) or not loops:
+        raise DomainError("domain JSON needs a non-empty 'loops' list (loop 0 is the outer "
+                          "boundary, further loops are holes)")
+    parsed = []
+    for li, loop in enumerate(loops):
+        if not isinstance(loop, list) or not loop:
+            raise DomainError(f"loop {li}: must be a non-empty list of segments")
+        parsed.append([_parse_segment(seg, li, si) for si, seg in enumerate(loop)])
+    return make_domain(parsed, units)
+
+
+def _where(li: int, si: int | None = None) -> str:
+    return f"loop {li}" if si is None else f"loop {li}, segment {si}"
+
+
+def _parse_point(value, where: str, what: str) -> np.ndarray:
+    if (not isinstance(value, (list, tuple)) or len(value) != 2
+            or not all(_is_number(v) for v in value)):
+        raise DomainError(f"{where}: {what} must be a pair of numbers, got {value!r}")
+    point = np.array([float(v) for v in value])
+    if not np.all(np.isfinite(point)):
+        raise DomainError(f"{where}: {what} has a non-finite coordinate {value!r}")
+    return point
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _parse_segment(seg, li: int, si: int):
+    where = _where(li, si)
+    if not isinstance(seg, dict) or len(seg) != 1:
+        raise DomainError(f"{where}: a segment is an object with one key: line, arc or circle")
+    (kind, value), = seg.items()
+    if kind == "line":
+        if not isinstance(value, list) or len(value) != 2:
+            raise DomainError(f"{where}: a line needs [[x0, y0], [x1, y1]]")
+        return Line(*(_parse_point(p, where, name) for p, name in zip(value, ("start", "end"))))
+    if kind == "arc":
+        if not isinstance(value, list) or len(value) != 3:
+            raise DomainError(f"{where}: an arc needs [[x0, y0], [xm, ym], [x1, y1]]")
+        names = ("start", "middle point", "end")
+        return tuple(_parse_point(p, where, name) for p, name in zip(value, names))
+    if kind == "circle":
+        if not isinstance(value, dict) or set(value) != {"center", "radius"}:
+            raise DomainError(f"{where}: a circle needs {{\"center\": [cx, cy], \"radius\": r}}")
+        center = _parse_point(value["center"], where, "center")
+        radius = value["radius"]
+        if not _is_number(radius) or not math.isfinite(radius):
+            raise DomainError(f"{where}: circle radius must be a finite number, got {radius!r}")
+        if radius <= 0:
+            raise DomainError(f"{where}: circle radius must be positive, got {radius!r}")
+        return Arc.circle(center, float(radius))
+    raise DomainError(f"{where}: unknown segment kind {kind!r} (expected line, arc or circle)")
+
+
+def make_domain(loops, units: str = "mm") -> Domain:
+    """Validate loops of curves and return the oriented Domain.
+
+    Arcs may be given as curves or as (start, middle, end) point triples; the latter are
+    checked for collinearity here, where the domain size that sets the tolerance is known.
+    """
+    size = _raw_size(loops)
+    eps = CLOSE_TOL * size
+    curves = [[_make_arc(c, li, si, eps) if isinstance(c, tuple) else c
+               for si, c in enumerate(loop)] for li, loop in enumerate(loops)]
+    for li, loop in enumerate(curves):
+        _check_loop_shape(loop, li, eps)
+    curves = [_close_loop(loop) for loop in curves]
+    for li, loop in enumerate(curves):
+        _check_not_flat(loop, li, eps)
+    _check_intersections(curves, eps)
+    oriented = []
+    for li, loop in enumerate(curves):
+        ccw = loop_signed_area(loop) > 0
+        want_ccw = li == 0
+        oriented.append(tuple(loop) if ccw == want_ccw else _reverse_loop(loop))
+    _check_nesting(oriented)
+    boxes = [curve_bbox(c) for loop in oriented for c in loop]
+    domain = Domain(tuple(oriented), units, np.min([b[0] for b in boxes], axis=0),
+                    np.max([b[1] for b in boxes], axis=0))
+    if domain.area <= 1e-12 * domain.size**2:
+        raise DomainError("the domain has zero area")
+    return domain
+
+
+def _raw_size(loops) -> float:
+    pts = []
+    for loop in loops:
+        for c in loop:
+            if isinstance(c, tuple):
+                pts.extend(c)
+            else:
+                pts.extend(curve_bbox(c))
+    pts = np.array(pts)
+    size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0))))
+    if size == 0.0:
+        raise DomainError("the domain has zero area (all its points coincide)")
+    return size
+
+
+def _make_arc(points, li: int, si: int, eps: float) -> Arc:
+    p0, pm, p1 = points
+    where = _where(li, si)
+    chord = float(np.hypot(*(p1 - p0)))
+    if chord <= eps:
+        raise DomainError(f"{where}: arc start and end coincide (use a circle for a full loop)")
+    if min(np.hypot(*(pm - p0)), np.hypot(*(pm - p1))) <= eps:
+        raise DomainError(f"{where}: arc middle point coincides with an end point")
+    # Height of the middle point above the chord, relative to the chord: 0 means a line.
+    height = abs(float((p1 - p0)[0] * (pm - p0)[1] - (p1 - p0)[1] * (pm - p0)[0])) / chord
+    if height <= 1e-9 * chord:
+        raise DomainError(f"{where}: arc points are collinear (use a line)")
+    return Arc.through(p0, pm, p1)
+
+
+def _check_loop_shape(loop, li: int, eps: float) -> None:
+    full = [si for si, c in enumerate(loop) if isinstance(c, Arc) and c.is_full]
+    if full and len(loop) > 1:
+        raise DomainError(f"{_where(li, full[0])}: a circle must be a loop by itself")
+    for si, c in enumerate(loop):
+        if isinstance(c, Line) and c.length <= eps:
+            raise DomainError(f"{_where(li, si)}: zero-length segment")
+    for si, c in enumerate(loop):
+        nxt = loop[(si + 1) % len(loop)]
+        gap = float(np.hypot(*(nxt.p0 - c.p1)))
+        if gap > eps:
+            if len(loop) == 1:
+                raise DomainError(f"{_where(li)}: open loop, its only segment does not end "
+                                  f"where it starts (gap {gap:.6g})")
+            raise DomainError(f"{_where(li)}: open loop, segment {si} ends at "
+                              f"{_fmt(c.p1)} but segment {(si + 1) % len(loop)} starts at "
+                              f"{_fmt(nxt.p0)} (gap {gap:.6g})")
+
+
+def _fmt(p) -> str:
+    return f"({p[0]:.9g}, {p[1]:.9g})"
+
+
+def _close_loop(loop) -> list:
+    """Make consecutive curves meet exactly (the gaps are already within tolerance)."""
+    if len(loop) == 1:
+        return list(loop)
+    out = [loop[0]]
+    for c in loop[1:]:
+        out.append(c.with_start(out[-1].p1))
+    first = out[0]
+    if not np.array_equal(first.p0, out[-1].p1):
+        out[0] = first.with_start(out[-1].p1)
+    return out
+
+
+def _check_not_flat(loop, li: int, eps: float) -> None:
+    if any(isinstance(c, Arc) for c in loop):
+        return
+    pts = np.array([c.p0 for c in loop])
+    centered = pts - pts.mean(axis=0)
+    if np.linalg.svd(centered, compute_uv=False)[-1] <= eps:
+        raise DomainError(f"{_where(li)}: zero area (all its points lie on one line)")
+
+
+def _check_intersections(loops, eps: float) -> None:
+    flat = [(li, si, c) for li, loop in enumerate(loops) for si, c in enumerate(loop)]
+    boxes = np.array([np.concatenate(curve_bbox(c)) for _, _, c in flat])
+    lo, hi = boxes[:, :2] - eps, boxes[:, 2:] + eps
+    touching = np.all((lo[:, None, :] <= hi[None, :, :]) & (lo[None, :, :] <= hi[:, None, :]),
+                      axis=2)
+    for i, j in zip(*np.nonzero(np.triu(touching, k=1))):
+        li, si, ci = flat[i]
+        lj, sj, cj = flat[j]
+        allowed = _shared_vertices(loops, li, si, lj, sj)
+        try:
+            points = curve_intersections(ci, cj, eps)
+        except Overlap:
+            raise DomainError(_pair_message(li, si, lj, sj, "overlap")) from None
+        for p in points:
+            if all(np.hypot(*(p - v)) > 10 * eps for v in allowed):
+                raise DomainError(_pair_message(li, si, lj, sj, f"cross at {_fmt(p)}"))
+
+
+def _shared_vertices(loops, li, si, lj, sj) -> list:
+    if li != lj:
+        return []
+    n = len(loops[li])
+    out = []
+    if (si + 1) % n == sj:
+        out.append(loops[li][sj].p0)
+    if (sj + 1) % n == si:
+        out.append(loops[li][si].p0)
+    return out
+
+
+def _pair_message(li, si, lj, sj, what: str) -> str:
+    if li == lj:
+        return f"loop {li} intersects itself: segments {si} and {sj} {what}"
+    return (f"loops {li} and {lj} intersect: loop {li} segment {si} and loop {lj} "
+            f"segment {sj} {what}")
+
+
+def _reverse_loop(loop) -> tuple:
+    return tuple(c.reversed() for c in reversed(loop))
+
+
+def _probe_point(loop):
+    """A point on the loop (loops do not meet, so it is inside another loop or outside)."""
+    c = loop[0]
+    return c.point(0.5)
+
+
+def _check_nesting(loops) -> None:
+    outer = loops[0]
+    for hi, hole in enumerate(loops[1:], start=1):
+        if winding_number(outer, _probe_point(hole)) == 0:
+            raise DomainError(f"loop {hi} (a hole) lies outside the outer loop 0; loop 0 must "
+                              "be the outer boundary")
+    for hi, hole in enumerate(loops[1:], start=1):
+        for hj, other in enumerate(loops[1:], start=1):
+            if hi != hj and winding_number(other, _probe_point(hole)) != 0:
+                raise DomainError(f"loop {hi} (a hole) lies inside hole loop {hj}")
