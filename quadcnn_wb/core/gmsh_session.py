@@ -63,3 +63,30 @@ def gmsh_session(threads: int = 1):
                     session.restore()
                     if previous_model:
                         gmsh.model.setCurrent(previous_model)
+
+
+@contextmanager
+def silenced_stdio():
+    """Mute C-level stdout/stderr: OpenCASCADE's readers print banners straight to fd 1."""
+    import os
+    import sys
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (AttributeError, ValueError, OSError):
+            pass
+    saved = []
+    try:
+        with open(os.devnull, "w") as devnull:
+            for fd in (1, 2):
+                try:
+                    saved.append((fd, os.dup(fd)))
+                    os.dup2(devnull.fileno(), fd)
+                except OSError:
+                    pass
+            yield
+    finally:
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)

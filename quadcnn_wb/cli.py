@@ -1,0 +1,85 @@
+"""Command line: `python -m quadcnn_wb COMMAND ...` (also installed as `quadcnn`).
+
+Exit status per DESIGN.md: 0 done; 2 bad input or unusable request, with one line on
+stderr starting with `error:` and no traceback; 1 only for a bug.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .core.atomic import write_json_atomic
+from .core.background import BackgroundMeshError, background_mesh
+from .core.domain import DomainError, load_domain
+
+
+class UsageError(Exception):
+    """A request the program cannot honour (bad option values, unwritable output)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one `error:` line, exit 2, as for every other bad request
+        self.exit(2, f"error: {message} (see '{self.prog} --help')\n")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 8:
+        raise argparse.ArgumentTypeError(f"expected at least 8, got {value}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="quadcnn", description="Block-structured quad meshing guided by "
+                     "frame fields and a CNN (see README.md).")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    bg = commands.add_parser("background", help="triangular background mesh of a domain")
+    bg.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
+    bg.add_argument("--nodes", type=_positive_int, default=2048,
+                    help="target node count (default 2048, held within 5%%)")
+    bg.add_argument("-o", "--output", help="write the mesh as JSON (DESIGN.md 'background')")
+    bg.add_argument("--png", help="write a picture of the mesh, boundary and corners")
+    bg.set_defaults(run=_run_background)
+    return parser
+
+
+def _check_output(path, suffixes) -> Path | None:
+    if path is None:
+        return None
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise UsageError(f"{path}: output must end in {' or '.join(sorted(suffixes))}")
+    if not path.parent.is_dir() and str(path.parent):
+        raise UsageError(f"{path}: the folder {path.parent} does not exist")
+    return path
+
+
+def _run_background(args) -> None:
+    out = _check_output(args.output, {".json"})
+    png = _check_output(args.png, {".png"})
+    domain = load_domain(args.input)
+    mesh = background_mesh(domain, nodes=args.nodes)
+    if out:
+        write_json_atomic(out, mesh.to_json())
+    if png:
+        from .viz.background_plot import plot_background
+
+        plot_background(domain, mesh, png)
+    print(f"{mesh.n_nodes} nodes, {len(mesh.triangles)} triangles, "
+          f"{len(mesh.boundary_nodes)} on the boundary, {len(mesh.corner_nodes)} corners")
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        args.run(args)
+    except (DomainError, BackgroundMeshError, UsageError, OSError) as exc:
+        message = " ".join(str(exc).split())
+        print(f"error: {message}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,171 @@
+"""STEP/BREP/IGES input: the first planar face of the file, as a Domain in its plane.
+
+Read through gmsh's OpenCASCADE importer so no FreeCAD is needed on the command line.
+Lines and circular arcs stay exact; other curve kinds (B-splines, ellipses) become
+polylines within CURVE_TOLERANCE of the domain size.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import gmsh
+import numpy as np
+
+from .curves import Arc, Line, circumcenter
+from .domain import DomainError, make_domain
+from .gmsh_session import gmsh_session, silenced_stdio
+
+CURVE_TOLERANCE = 1e-4  # chordal deviation allowed for curves that are not lines or arcs
+EXACT_TOLERANCE = 1e-5  # a curve this close to a line or circle is taken as one (IGES
+#                         writers store circles as B-splines that are off by ~1e-6)
+
+
+def read_cad_face(path) -> object:
+    path = Path(path)
+    if not path.is_file():
+        raise DomainError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise DomainError(f"{path}: the file is empty")
+    with gmsh_session():
+        try:
+            with silenced_stdio():
+                gmsh.model.occ.importShapes(str(path), highestDimOnly=False)
+                gmsh.model.occ.synchronize()
+        except Exception as exc:  # gmsh reports every reader failure as a bare Exception
+            raise DomainError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()}: "
+                              f"{_first_line(exc)}") from None
+        faces = [tag for _, tag in gmsh.model.getEntities(2)]
+        if not faces:
+            raise DomainError(f"{path}: the file holds no face")
+        planar = [tag for tag in faces if gmsh.model.getType(2, tag) == "Plane"]
+        if not planar:
+            raise DomainError(f"{path}: no planar face (the first face is a "
+                              f"{gmsh.model.getType(2, faces[0])} surface)")
+        face = planar[0]
+        frame = _plane_frame(face)
+        loops = _face_loops(face, frame)
+    loops.sort(key=lambda loop: -_extent(loop))  # holes lie inside: the outer loop is widest
+    return make_domain(loops, units="mm")
+
+
+def _first_line(exc) -> str:
+    text = str(exc).strip() or type(exc).__name__
+    return text.splitlines()[0]
+
+
+def _plane_frame(face: int):
+    """Origin and in-plane axes; a face in the XY plane keeps its own x and y."""
+    lo, hi = gmsh.model.getParametrizationBounds(2, face)
+    uv = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2]
+    normal = np.array(gmsh.model.getNormal(face, uv))
+    normal /= np.linalg.norm(normal)
+    point = np.array(gmsh.model.getValue(2, face, uv))
+    if normal[2] < 0:
+        normal = -normal
+    x_axis = np.array([1.0, 0.0, 0.0])
+    if abs(np.dot(x_axis, normal)) > 0.9:
+        x_axis = np.array([0.0, 1.0, 0.0]) if abs(normal[2]) < 0.9 else x_axis
+    x_axis = x_axis - np.dot(x_axis, normal) * normal
+    if np.linalg.norm(x_axis) < 1e-9:
+        x_axis = np.array([0.0, 1.0, 0.0]) - normal[1] * normal
+    x_axis /= np.linalg.norm(x_axis)
+    y_axis = np.cross(normal, x_axis)
+    origin = np.dot(point, normal) * normal  # the plane's point nearest the global origin
+    return origin, x_axis, y_axis
+
+
+def _to_plane(frame, xyz) -> np.ndarray:
+    origin, ex, ey = frame
+    d = np.asarray(xyz, dtype=float).reshape(-1, 3) - origin
+    return np.stack([d @ ex, d @ ey], axis=-1)
+
+
+def _face_loops(face: int, frame) -> list:
+    _, curve_lists = gmsh.model.occ.getCurveLoops(face)
+    loops = []
+    for curve_tags in curve_lists:
+        pieces = []
+        for tag in curve_tags:
+            pieces.extend(_curve_pieces(abs(int(tag)), frame))
+        loops.append(_chain(pieces))
+    return loops
+
+
+def _curve_pieces(tag: int, frame) -> list:
+    """Exact line or arc when the curve is one (whatever OCC calls it), else a polyline."""
+    lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+    u0, u1 = float(lo[0]), float(hi[0])
+
+    def at(us):
+        return _to_plane(frame, gmsh.model.getValue(1, tag, list(us)))
+
+    probe = at(np.linspace(u0, u1, 33))
+    span = float(np.ptp(probe, axis=0).max())
+    tol = EXACT_TOLERANCE * max(span, 1e-300)
+    closed = np.hypot(*(probe[-1] - probe[0])) <= 1e-9 * max(span, 1e-300)
+    chord = probe[-1] - probe[0]
+    if not closed and np.max(np.abs(np.cross(chord, probe - probe[0]))) <= tol * np.hypot(*chord):
+        return [Line(probe[0], probe[-1])]
+    center = circumcenter(probe[0], probe[11], probe[22])
+    if np.all(np.isfinite(center)):
+        radii = np.hypot(*(probe - center).T)
+        if np.ptp(radii) <= tol:
+            if closed:
+                return [Arc.circle(center, float(radii.mean()))]
+            return [(probe[0], probe[16], probe[-1])]
+    return _polyline(at, u0, u1, span)
+
+
+def _polyline(at, u0: float, u1: float, span: float) -> list:
+    """Lines through points spaced so the chordal error stays within CURVE_TOLERANCE."""
+    dense = at(np.linspace(u0, u1, 257))
+    steps = np.diff(dense, axis=0)
+    seg = np.hypot(*steps.T)
+    turn = np.abs(np.diff(np.unwrap(np.arctan2(steps[:, 1], steps[:, 0]))))
+    curvature = float((turn / np.maximum(seg[1:], 1e-300)).max()) if len(turn) else 0.0
+    # A chord of length c on curvature k deviates by about k c^2 / 8.
+    pieces = float(np.sum(seg)) * math.sqrt(curvature / (8 * CURVE_TOLERANCE * span))
+    n = int(min(256, max(4, math.ceil(pieces))))
+    p = at(np.linspace(u0, u1, n + 1))
+    return [Line(a, b) for a, b in zip(p[:-1], p[1:])]
+
+
+def _endpoints(piece):
+    return (piece[0], piece[2]) if isinstance(piece, tuple) else (piece.p0, piece.p1)
+
+
+def _reverse(piece):
+    return (piece[2], piece[1], piece[0]) if isinstance(piece, tuple) else piece.reversed()
+
+
+def _chain(pieces: list) -> list:
+    """Order and orient a loop's curves so each starts where the previous one ends."""
+    if len(pieces) == 1:
+        return pieces
+    remaining = list(pieces)
+    chain = [remaining.pop(0)]
+    while remaining:
+        end = _endpoints(chain[-1])[1]
+        best, best_dist, flip = None, math.inf, False
+        for i, piece in enumerate(remaining):
+            a, b = _endpoints(piece)
+            for dist, rev in ((np.hypot(*(a - end)), False), (np.hypot(*(b - end)), True)):
+                if dist < best_dist:
+                    best, best_dist, flip = i, dist, rev
+        piece = remaining.pop(best)
+        chain.append(_reverse(piece) if flip else piece)
+    return chain
+
+
+def _extent(loop) -> float:
+    pts = []
+    for piece in loop:
+        if isinstance(piece, tuple):
+            pts.extend(piece)
+        elif isinstance(piece, Arc) and piece.is_full:
+            pts.extend([piece.center - piece.radius, piece.center + piece.radius])
+        else:
+            pts.extend([piece.p0, piece.p1])
+    return float(np.hypot(*np.ptp(np.array(pts), axis=0)))
