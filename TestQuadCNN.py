@@ -1,0 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""FreeCAD-side tests, run by `freecadcmd -t TestQuadCNN` (registered in Init.py)."""
+
+from quadcnn_wb.freecad.tests.test_app import *  # noqa: F401,F403

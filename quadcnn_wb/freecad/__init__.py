@@ -1,0 +1,1 @@
+"""FreeCAD side of QuadCNN: everything that imports FreeCAD lives under this package."""
