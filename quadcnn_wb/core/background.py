@@ -20,7 +20,9 @@ from .curves import Arc, cross2
 from .domain import Domain
 from .gmsh_session import gmsh_session
 
-NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes
+NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
+NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
+#                  whole edges gain a node at once and the count moves in steps of ~20
 MAX_SIZE_ITERATIONS = 12
 CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not corners
 GMSH_ALGORITHM = 6  # Frontal-Delaunay: near-equilateral triangles, no smoothing needed
@@ -76,15 +78,52 @@ def size_for_nodes(area: float, perimeter: float, holes: int, target: int) -> fl
     return 1.0 / inv_h
 
 
+class SizeSearch:
+    """Element size for a node count: bracketing secant search in log space.
+
+    The count falls with the size but in steps (a thin strip gains a whole row at once),
+    so a plain proportional update can jump over the target forever; keeping the sizes
+    known to give too many and too few nodes makes each step land between them.
+    """
+
+    def __init__(self, target: int, h: float):
+        self.target, self.h = target, h
+        self.too_fine: tuple[float, int] | None = None  # (h, count) with count > target
+        self.too_coarse: tuple[float, int] | None = None
+        self.steps = 0
+
+    def update(self, count: int) -> bool:
+        """Record the count of the current size; False when the search must stop."""
+        self.steps += 1
+        if self.steps >= MAX_SIZE_ITERATIONS:
+            return False
+        if count > self.target:
+            self.too_fine = (self.h, count)
+        else:
+            self.too_coarse = (self.h, count)
+        if self.too_fine and self.too_coarse:
+            (h0, n0), (h1, n1) = self.too_fine, self.too_coarse
+            if h1 / h0 < 1.0 + 1e-6 or n0 == n1:
+                return False
+            slope = math.log(n1 / n0) / math.log(h1 / h0)
+            guess = math.exp(math.log(h0) + math.log(self.target / n0) / slope)
+            # Stay well inside the bracket so a step-shaped count still narrows it.
+            lo, hi = h0 * (h1 / h0) ** 0.1, h0 * (h1 / h0) ** 0.9
+            self.h = min(hi, max(lo, guess))
+        else:
+            self.h *= (count / self.target) ** 0.5
+        return True
+
+
 def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1) -> BackgroundMesh:
-    """Triangulate the domain with about ``nodes`` nodes (within NODE_TOLERANCE)."""
+    """Triangulate the domain with ``nodes`` nodes, within NODE_TOLERANCE or NODE_SLACK."""
     if nodes < 8:
         raise ValueError(f"--nodes must be at least 8, got {nodes}")
     scale, center = domain.size, domain.center
     unit_area = domain.area / scale**2
     unit_perimeter = domain.perimeter / scale
     h = size_for_nodes(unit_area, unit_perimeter, domain.holes, nodes / GMSH_DENSITY)
-    tolerance = max(NODE_TOLERANCE * nodes, 2.0)
+    tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
     with gmsh_session(threads) as session:
         curve_tags = _build_geometry(domain, center, scale)
@@ -94,18 +133,18 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1) -> Back
                               ("Mesh.MeshSizeExtendFromBoundary", 1),
                               ("Mesh.Smoothing", 0), ("Mesh.Optimize", 0)):
             session.set(option, value)
-        for _ in range(MAX_SIZE_ITERATIONS):
-            session.set("Mesh.MeshSizeMin", h)
-            session.set("Mesh.MeshSizeMax", h)
+        search = SizeSearch(nodes, h)
+        while True:
+            session.set("Mesh.MeshSizeMin", search.h)
+            session.set("Mesh.MeshSizeMax", search.h)
             gmsh.model.mesh.clear()
             gmsh.model.mesh.generate(2)
             raw = _read_mesh(curve_tags)
             count = len(raw[0])
             if best is None or abs(count - nodes) < abs(len(best[0][0]) - nodes):
-                best = (raw, h)
-            if abs(count - nodes) <= tolerance:
+                best = (raw, search.h)
+            if abs(count - nodes) <= tolerance or not search.update(count):
                 break
-            h *= math.sqrt(count / nodes)
     (coords, triangles, curve_nodes), h = best
     if abs(len(coords) - nodes) > tolerance:
         raise BackgroundMeshError(
