@@ -1,0 +1,108 @@
+"""STEP/BREP/IGES input through gmsh's OpenCASCADE reader: written here by gmsh, read back."""
+
+from __future__ import annotations
+
+import math
+
+import gmsh
+import numpy as np
+import pytest
+
+from quadcnn_wb.core.background import background_mesh
+from quadcnn_wb.core.domain import DomainError, load_domain
+from quadcnn_wb.core.gmsh_session import gmsh_session, silenced_stdio
+
+PLATE_AREA = 2.0 - math.pi * 0.25**2
+
+
+def write_cad(path, build):
+    """Build OCC shapes with ``build(occ)`` and write them to ``path`` with gmsh."""
+    with gmsh_session(), silenced_stdio():
+        build(gmsh.model.occ)
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(path))
+    return path
+
+
+def plate_with_hole(occ):
+    plate = occ.addRectangle(0, 0, 0, 2, 1)
+    hole = occ.addDisk(1, 0.5, 0, 0.25, 0.25)
+    occ.cut([(2, plate)], [(2, hole)])
+
+
+@pytest.mark.parametrize("suffix", [".step", ".brep", ".iges"])
+def test_plate_with_hole_round_trip(tmp_path, suffix):
+    domain = load_domain(write_cad(tmp_path / f"plate{suffix}", plate_with_hole))
+    assert [[c.kind for c in loop] for loop in domain.loops] == [["line"] * 4, ["circle"]]
+    hole = domain.loops[1][0]
+    assert hole.center == pytest.approx(np.array([1.0, 0.5]), abs=1e-6)
+    assert hole.radius == pytest.approx(0.25, rel=1e-6)
+    assert domain.area == pytest.approx(PLATE_AREA, rel=1e-6)
+    mesh = background_mesh(domain, nodes=800)
+    assert abs(mesh.n_nodes - 800) <= 40
+
+
+def test_face_in_a_tilted_plane_maps_to_its_plane_coordinates(tmp_path):
+    def tilted(occ):
+        plate_with_hole(occ)
+        occ.rotate(occ.getEntities(2), 0, 0, 0, 1, 1, 0, 0.7)
+        occ.translate(occ.getEntities(2), 5, -2, 3)
+
+    domain = load_domain(write_cad(tmp_path / "tilted.step", tilted))
+    assert domain.area == pytest.approx(PLATE_AREA, rel=1e-9)
+    assert domain.loops[1][0].radius == pytest.approx(0.25, rel=1e-9)
+
+
+def test_arcs_stay_arcs(tmp_path):
+    def slot(occ):
+        occ.addRectangle(0, 0, 0, 3, 1, roundedRadius=0.3)
+
+    domain = load_domain(write_cad(tmp_path / "slot.step", slot))
+    kinds = sorted(c.kind for c in domain.loops[0])
+    assert kinds == ["arc"] * 4 + ["line"] * 4
+    assert domain.area == pytest.approx(3.0 - (4 - math.pi) * 0.09, rel=1e-9)
+    for arc in (c for c in domain.loops[0] if c.kind == "arc"):
+        assert arc.radius == pytest.approx(0.3, rel=1e-9)
+
+
+def test_first_planar_face_of_a_solid(tmp_path):
+    domain = load_domain(write_cad(tmp_path / "box.step", lambda occ: occ.addBox(0, 0, 0, 1, 2, 3)))
+    assert domain.area in (pytest.approx(2.0), pytest.approx(3.0), pytest.approx(6.0))
+
+
+def test_spline_edges_become_fine_polylines(tmp_path):
+    def blob(occ):
+        pts = [occ.addPoint(x, y, 0) for x, y in [(0, 0), (2, -0.3), (3, 1), (1, 2), (-0.5, 1)]]
+        curve = occ.addBSpline(pts + [pts[0]])
+        occ.addPlaneSurface([occ.addCurveLoop([curve])])
+
+    domain = load_domain(write_cad(tmp_path / "blob.step", blob))
+    assert all(c.kind == "line" for c in domain.loops[0])
+    assert len(domain.loops[0]) >= 16
+
+
+def test_non_planar_file_is_refused(tmp_path):
+    path = write_cad(tmp_path / "ball.step", lambda occ: occ.addSphere(0, 0, 0, 1))
+    with pytest.raises(DomainError, match="no planar face"):
+        load_domain(path)
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"", "the file is empty"),
+    (b"this is not a STEP file\n", "cannot read as STEP"),
+    (None, "cannot read as STEP"),  # truncated
+])
+def test_corrupt_files_are_refused(tmp_path, content, message):
+    if content is None:
+        full = write_cad(tmp_path / "full.step", plate_with_hole).read_bytes()
+        content = full[: len(full) // 3]
+    path = tmp_path / "bad.step"
+    path.write_bytes(content)
+    with pytest.raises(DomainError, match=message):
+        load_domain(path)
+    assert not gmsh.isInitialized()
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(DomainError, match="no such file"):
+        load_domain(tmp_path / "nothing.step")

@@ -1,0 +1,57 @@
+"""The project's fixed layout and the import rules of DESIGN.md."""
+
+from __future__ import annotations
+
+import ast
+import os
+import xml.etree.ElementTree as ET
+
+from conftest import REPO
+
+FORBIDDEN_IN_CORE = {"FreeCAD", "FreeCADGui", "Part", "Sketcher", "Fem", "torch", "PySide",
+                     "PySide2", "onnxruntime"}
+
+
+def imported_modules(path):
+    tree = ast.parse(path.read_text(), filename=str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            yield from (alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            yield node.module.split(".")[0]
+
+
+def test_top_level_layout():
+    for name in ["InitGui.py", "Init.py", "quadcnn_wb", "resources", "tests", "package.xml",
+                 "README.md", "pyproject.toml", "Makefile", "LICENSE", "TestQuadCNN.py"]:
+        assert (REPO / name).exists(), name
+    assert os.access(REPO / ".ci" / "run", os.X_OK)
+    assert "GNU LESSER GENERAL PUBLIC LICENSE" in (REPO / "LICENSE").read_text()[:200]
+    assert "Version 2.1" in (REPO / "LICENSE").read_text()[:300]
+
+
+def test_core_never_imports_freecad_torch_or_onnxruntime():
+    for path in (REPO / "quadcnn_wb" / "core").rglob("*.py"):
+        bad = set(imported_modules(path)) & FORBIDDEN_IN_CORE
+        assert not bad, f"{path.name} imports {bad}"
+
+
+def test_package_xml_is_an_addon_manager_workbench():
+    ns = {"p": "https://wiki.freecad.org/Package_Metadata"}
+    root = ET.parse(REPO / "package.xml").getroot()
+    assert root.find("p:name", ns).text == "QuadCNN"
+    assert root.find("p:license", ns).text == "LGPL-2.1-or-later"
+    wb = root.find("p:content/p:workbench", ns)
+    assert wb.find("p:classname", ns).text == "QuadCNNWorkbench"
+    assert wb.find("p:subdirectory", ns).text == "./"
+    assert wb.find("p:freecadmin", ns).text.startswith("0.20")
+    icon = wb.find("p:icon", ns).text
+    assert (REPO / icon).is_file() and (REPO / icon).read_text().lstrip().startswith("<?xml")
+    deps = {d.text for d in wb.findall("p:depend", ns) if d.get("type") == "python"}
+    assert {"gmsh", "onnxruntime", "numpy", "scipy"} <= deps
+
+
+def test_readme_starts_with_the_two_commands():
+    text = (REPO / "README.md").read_text()
+    first_block = text[: text.index("make test") + 20]
+    assert "make demo" in first_block and len(first_block) < 1500
