@@ -11,12 +11,13 @@ OUT := out
 export LANG := C.UTF-8
 export QTWEBENGINE_CHROMIUM_FLAGS := --no-sandbox
 
-.PHONY: help setup system-packages venv link demo test lint clean
+.PHONY: help setup system-packages venv link demo test lint bench clean
 
 help:
 	@echo "make demo   - set up, then mesh a bundled example and write pictures to $(OUT)/"
 	@echo "make test   - set up, then run ruff and the whole test suite"
 	@echo "make setup  - install what is missing (Debian packages, $(VENV), FreeCAD Mod link)"
+	@echo "make bench  - print background meshing times against bare gmsh"
 
 setup: system-packages $(STAMP) link
 
@@ -55,6 +56,10 @@ lint: setup
 
 test: setup lint
 	$(PY) -m pytest -q
+
+# Speed figures (not part of the test suite).
+bench: setup
+	$(PY) -m quadcnn_wb.bench.background_speed
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache

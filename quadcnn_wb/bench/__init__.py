@@ -1,0 +1,1 @@
+"""Benchmark commands: they print figures; no timing is asserted in unit tests."""
