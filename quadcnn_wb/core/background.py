@@ -44,6 +44,7 @@ class BackgroundMesh:
     boundary_tangent: np.ndarray  # (B, 2) unit tangent; domain on the left
     corner_nodes: np.ndarray  # (C,) int, loop vertices where the tangent turns
     corner_angles: np.ndarray  # (C,) interior angle in radians, in (0, 2*pi]
+    corner_tangents_in: np.ndarray  # (C, 2) unit tangent of the curve arriving at the corner
     element_size: float
 
     @property
@@ -220,7 +221,7 @@ def _read_mesh(curve_tags: dict):
 def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMesh:
     coords = np.array(coords, dtype=float)
     boundary, loops_of, segs_of, params, tangents = [], [], [], [], []
-    corner_nodes, corner_angles = [], []
+    corner_nodes, corner_angles, corner_in = [], [], []
     for li, loop in enumerate(domain.loops):
         for si, curve in enumerate(loop):
             ids = curve_nodes[(li, si)]
@@ -244,6 +245,7 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMe
                 if abs(angle - math.pi) > CORNER_MIN_TURN:
                     corner_nodes.append(int(ids[0]))
                     corner_angles.append(angle)
+                    corner_in.append(loop[si - 1].tangent(1.0))
     triangles = _counter_clockwise(coords, np.asarray(triangles, dtype=np.int64))
     return BackgroundMesh(
         nodes=coords, triangles=triangles, boundary_nodes=np.array(boundary, dtype=np.int64),
@@ -252,7 +254,9 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMe
         boundary_param=np.array(params, dtype=float),
         boundary_tangent=np.array(tangents, dtype=float).reshape(-1, 2),
         corner_nodes=np.array(corner_nodes, dtype=np.int64),
-        corner_angles=np.array(corner_angles, dtype=float), element_size=float(h))
+        corner_angles=np.array(corner_angles, dtype=float),
+        corner_tangents_in=np.array(corner_in, dtype=float).reshape(-1, 2),
+        element_size=float(h))
 
 
 def _interior_angle(incoming, outgoing) -> float:

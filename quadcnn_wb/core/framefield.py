@@ -1,0 +1,235 @@
+"""Boundary-aligned cross field on the background mesh, and its singular points.
+
+A cross (four directions a quarter turn apart) is stored as the complex number
+z = exp(4i·theta), which is the same for all four of its directions, so crosses can be
+averaged and interpolated linearly.  Boundary nodes get z = t^4 of their unit tangent
+(the cross contains the tangent exactly); the interior solves the cotangent Laplace
+equation with those values (the harmonic / heat-diffusion field of Kowalski et al. and
+gmsh's qmtCrossField, without the renormalisation loop: the linear solve is what keeps the
+field free of spurious ± singularity pairs and costs a few milliseconds).  A singular
+point is a zero of the piecewise-linear z: a triangle around which arg z turns by ±2π.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from .background import BackgroundMesh
+
+
+@dataclass(frozen=True)
+class Singularity:
+    xy: np.ndarray  # position inside its triangle (the zero of the linear interpolant)
+    valence: int  # 3 or 5
+    triangle: int
+    directions: np.ndarray  # (valence, 2) unit separatrix directions leaving the point
+
+
+@dataclass(frozen=True)
+class CornerSource:
+    """A boundary corner whose angle rounds to 270° or 360°: streamlines leave it too."""
+
+    node: int
+    xy: np.ndarray
+    angle: float  # interior angle, radians
+    directions: np.ndarray  # (k, 2) unit directions into the domain, continuing the edges
+
+
+@dataclass(frozen=True)
+class FrameField:
+    z: np.ndarray  # (N,) complex, the harmonic representation (|z| < 1 inside)
+    theta: np.ndarray  # (N,) one direction of each cross, radians in (-pi/4, pi/4]
+    singularities: tuple
+    corner_sources: tuple
+
+    @property
+    def frames(self) -> np.ndarray:
+        """(N, 4): the paper's two perpendicular unit vectors per node (v1x, v1y, v2x, v2y)."""
+        c, s = np.cos(self.theta), np.sin(self.theta)
+        return np.stack([c, s, -s, c], axis=1)
+
+    def valences(self) -> dict:
+        counts = {3: 0, 5: 0}
+        for sing in self.singularities:
+            counts[sing.valence] += 1
+        return counts
+
+
+def cotangent_laplacian(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matrix:
+    """Stiffness matrix of P1 finite elements (positive semi-definite)."""
+    n = len(nodes)
+    rows, cols, vals = [], [], []
+    for k in range(3):
+        i, j, o = triangles[:, (k + 1) % 3], triangles[:, (k + 2) % 3], triangles[:, k]
+        a, b = nodes[i] - nodes[o], nodes[j] - nodes[o]
+        cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        cot = (a * b).sum(axis=1) / np.maximum(np.abs(cross), 1e-300)
+        w = 0.5 * cot
+        rows += [i, j, i, j]
+        cols += [j, i, i, j]
+        vals += [-w, -w, w, w]
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+def boundary_values(mesh: BackgroundMesh) -> np.ndarray:
+    """z on boundary nodes: the tangent's fourth power; a corner blends its two edges.
+
+    At a corner whose angle is a whole number of quarter turns both edges give the same
+    z, so the cross contains both edges exactly; otherwise it splits the difference.
+    """
+    t = mesh.boundary_tangent[:, 0] + 1j * mesh.boundary_tangent[:, 1]
+    z = t**4
+    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    for node, t_in in zip(mesh.corner_nodes, mesh.corner_tangents_in):
+        k = position[int(node)]
+        blend = complex(*t_in) ** 4 + z[k]
+        if abs(blend) > 1e-9:
+            z[k] = blend / abs(blend)
+    return z
+
+
+def solve_cross_field(mesh: BackgroundMesh, boundary_z: np.ndarray | None = None) -> np.ndarray:
+    """Harmonic z with the boundary values fixed (Dirichlet)."""
+    n = mesh.n_nodes
+    bz = boundary_values(mesh) if boundary_z is None else boundary_z
+    is_boundary = np.zeros(n, dtype=bool)
+    is_boundary[mesh.boundary_nodes] = True
+    interior = np.nonzero(~is_boundary)[0]
+    z = np.zeros(n, dtype=complex)
+    z[mesh.boundary_nodes] = bz
+    if len(interior):
+        lap = cotangent_laplacian(mesh.nodes, mesh.triangles)
+        l_ii = lap[interior][:, interior].tocsc()
+        rhs = -(lap[interior][:, mesh.boundary_nodes] @ bz)
+        lu = splu(l_ii)
+        z[interior] = lu.solve(rhs.real) + 1j * lu.solve(rhs.imag)
+    return z
+
+
+def triangle_windings(z: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Turns of arg z around each triangle (each edge's change wrapped to (-pi, pi])."""
+    ang = np.angle(z)
+    total = np.zeros(len(triangles))
+    for k in range(3):
+        d = ang[triangles[:, (k + 1) % 3]] - ang[triangles[:, k]]
+        total += (d + np.pi) % (2 * np.pi) - np.pi
+    return np.rint(total / (2 * np.pi)).astype(int)
+
+
+def compute_frame_field(mesh: BackgroundMesh) -> FrameField:
+    z = solve_cross_field(mesh)
+    theta = np.angle(z) / 4.0
+    windings = triangle_windings(z, mesh.triangles)
+    singularities = tuple(_singularity(mesh, z, int(t), int(windings[t]))
+                          for t in np.nonzero(windings)[0])
+    return FrameField(z=z, theta=theta, singularities=singularities,
+                      corner_sources=corner_sources(mesh))
+
+
+def _linear_model(mesh, z, tri):
+    """z(p) = z0 + a·(p - p0) on the triangle, as complex gradient parts (dz/dx, dz/dy)."""
+    i, j, k = mesh.triangles[tri]
+    p0, p1, p2 = mesh.nodes[i], mesh.nodes[j], mesh.nodes[k]
+    m = np.array([p1 - p0, p2 - p0])
+    dz = np.array([z[j] - z[i], z[k] - z[i]])
+    grad = np.linalg.solve(m, dz)  # (dz/dx, dz/dy)
+    return p0, z[i], grad
+
+
+def _singularity(mesh, z, tri: int, winding: int) -> Singularity:
+    p0, z0, (zx, zy) = _linear_model(mesh, z, tri)
+    # Zero of z0 + zx*dx + zy*dy, as a real 2x2 system.
+    a = np.array([[zx.real, zy.real], [zx.imag, zy.imag]])
+    try:
+        d = np.linalg.solve(a, [-z0.real, -z0.imag])
+        xy = p0 + d
+    except np.linalg.LinAlgError:
+        xy = mesh.nodes[mesh.triangles[tri]].mean(axis=0)
+    corners = mesh.nodes[mesh.triangles[tri]]
+    if not _inside_triangle(xy, corners):
+        xy = _clamp_into_triangle(xy, corners)
+    valence = 4 - winding
+    if valence not in (3, 5):
+        raise ValueError(f"singular point of valence {valence} in triangle {tri}; the field "
+                         "has a higher-order zero")
+    return Singularity(xy=xy, valence=valence, triangle=tri,
+                       directions=separatrix_directions(zx, zy, valence))
+
+
+def _inside_triangle(p, corners, tol=1e-12) -> bool:
+    a, b, c = corners
+    m = np.array([b - a, c - a]).T
+    try:
+        u, v = np.linalg.solve(m, p - a)
+    except np.linalg.LinAlgError:
+        return False
+    return u >= -tol and v >= -tol and u + v <= 1 + tol
+
+
+def _clamp_into_triangle(p, corners):
+    a, b, c = corners
+    m = np.array([b - a, c - a]).T
+    u, v = np.linalg.lstsq(m, p - a, rcond=None)[0]
+    u, v = max(u, 0.0), max(v, 0.0)
+    s = u + v
+    if s > 1:
+        u, v = u / s, v / s
+    return a + u * (b - a) + v * (c - a)
+
+
+def separatrix_directions(zx: complex, zy: complex, valence: int) -> np.ndarray:
+    """Directions phi where the cross near the zero contains the radial direction.
+
+    Around the zero, z(r e^{i phi}) = r (A e^{i phi} + B e^{-i phi}) with A, B from the
+    gradient; a separatrix leaves where arg z = 4 phi, i.e. g(phi) = A e^{-3i phi} +
+    B e^{-5i phi} is real and positive.  g winds -3 or -5 times: 3 or 5 such directions.
+    """
+    a = 0.5 * (zx - 1j * zy)
+    b = 0.5 * (zx + 1j * zy)
+    phi = np.linspace(0.0, 2 * np.pi, 2049)
+    g = a * np.exp(-3j * phi) + b * np.exp(-5j * phi)
+    arg = np.angle(g)
+    roots = []
+    for k in range(len(phi) - 1):
+        if arg[k] == 0.0 or (arg[k] * arg[k + 1] < 0 and abs(arg[k] - arg[k + 1]) < np.pi):
+            lo, hi = phi[k], phi[k + 1]
+            flo = arg[k]
+            for _ in range(40):
+                mid = 0.5 * (lo + hi)
+                fm = np.angle(a * np.exp(-3j * mid) + b * np.exp(-5j * mid))
+                if (fm < 0) == (flo < 0):
+                    lo, flo = mid, fm
+                else:
+                    hi = mid
+            roots.append(0.5 * (lo + hi))
+    roots = np.array(roots)
+    if len(roots) != valence:
+        # Degenerate gradient: fall back to evenly spaced directions from the strongest root.
+        start = roots[0] if len(roots) else 0.0
+        roots = start + 2 * np.pi * np.arange(valence) / valence
+    return np.stack([np.cos(roots), np.sin(roots)], axis=1)
+
+
+def corner_sources(mesh: BackgroundMesh) -> tuple:
+    """Corners of 270° or 360° (after rounding to quarter turns), with their directions."""
+    out = []
+    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    for node, angle in zip(mesh.corner_nodes, mesh.corner_angles):
+        quarters = int(round(angle / (math.pi / 2)))
+        if quarters < 3:
+            continue
+        t_out = mesh.boundary_tangent[position[int(node)]]
+        step = angle / quarters
+        dirs = []
+        for j in range(1, quarters):
+            c, s = math.cos(j * step), math.sin(j * step)
+            dirs.append([c * t_out[0] - s * t_out[1], s * t_out[0] + c * t_out[1]])
+        out.append(CornerSource(node=int(node), xy=mesh.nodes[node].copy(), angle=float(angle),
+                                directions=np.array(dirs)))
+    return tuple(out)
