@@ -126,32 +126,52 @@ def compute_frame_field(mesh: BackgroundMesh) -> FrameField:
     z = solve_cross_field(mesh)
     theta = np.angle(z) / 4.0
     windings = triangle_windings(z, mesh.triangles)
-    singularities = tuple(_singularity(mesh, z, int(t), int(windings[t]))
-                          for t in np.nonzero(windings)[0])
+    singular = np.nonzero(windings)[0]
+    patches = _triangle_patches(mesh.triangles, singular)
+    singularities = tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
+                          for t, patch in zip(singular, patches))
     return FrameField(z=z, theta=theta, singularities=singularities,
                       corner_sources=corner_sources(mesh))
 
 
-def _linear_model(mesh, z, tri):
-    """z(p) = z0 + a·(p - p0) on the triangle, as complex gradient parts (dz/dx, dz/dy)."""
-    i, j, k = mesh.triangles[tri]
-    p0, p1, p2 = mesh.nodes[i], mesh.nodes[j], mesh.nodes[k]
-    m = np.array([p1 - p0, p2 - p0])
-    dz = np.array([z[j] - z[i], z[k] - z[i]])
-    grad = np.linalg.solve(m, dz)  # (dz/dx, dz/dy)
-    return p0, z[i], grad
+def _triangle_patches(triangles: np.ndarray, chosen: np.ndarray) -> list:
+    """Nodes of every triangle touching each chosen triangle (its one-ring patch)."""
+    if not len(chosen):
+        return []
+    touching = {}
+    for t, tri in enumerate(triangles):
+        for n in tri:
+            touching.setdefault(int(n), []).append(t)
+    out = []
+    for t in chosen:
+        around = {u for n in triangles[t] for u in touching[int(n)]}
+        out.append(np.unique(triangles[sorted(around)]))
+    return out
 
 
-def _singularity(mesh, z, tri: int, winding: int) -> Singularity:
-    p0, z0, (zx, zy) = _linear_model(mesh, z, tri)
-    # Zero of z0 + zx*dx + zy*dy, as a real 2x2 system.
+def _linear_fit(mesh, z, patch, centre):
+    """Least-squares z(p) = z0 + zx (x - cx) + zy (y - cy) over the patch's nodes.
+
+    A patch fit rather than the singular triangle alone: three nodal values next to a
+    zero are the noisiest of the field, and the separatrix directions come from this
+    gradient.
+    """
+    d = mesh.nodes[patch] - centre
+    a = np.column_stack([np.ones(len(patch)), d])
+    coef, *_ = np.linalg.lstsq(a, z[patch], rcond=None)
+    return coef[0], coef[1], coef[2]
+
+
+def _singularity(mesh, z, tri: int, winding: int, patch) -> Singularity:
+    corners = mesh.nodes[mesh.triangles[tri]]
+    centre = corners.mean(axis=0)
+    z0, zx, zy = _linear_fit(mesh, z, patch, centre)
+    # Zero of the fitted model, as a real 2x2 system; kept inside its triangle.
     a = np.array([[zx.real, zy.real], [zx.imag, zy.imag]])
     try:
-        d = np.linalg.solve(a, [-z0.real, -z0.imag])
-        xy = p0 + d
+        xy = centre + np.linalg.solve(a, [-z0.real, -z0.imag])
     except np.linalg.LinAlgError:
-        xy = mesh.nodes[mesh.triangles[tri]].mean(axis=0)
-    corners = mesh.nodes[mesh.triangles[tri]]
+        xy = centre
     if not _inside_triangle(xy, corners):
         xy = _clamp_into_triangle(xy, corners)
     valence = 4 - winding
