@@ -17,7 +17,7 @@ help:
 	@echo "make demo   - set up, then mesh a bundled example and write pictures to $(OUT)/"
 	@echo "make test   - set up, then run ruff and the whole test suite"
 	@echo "make setup  - install what is missing (Debian packages, $(VENV), FreeCAD Mod link)"
-	@echo "make bench  - print background meshing times against bare gmsh"
+	@echo "make bench  - print background, field and tracing times"
 
 setup: system-packages $(STAMP) link
 
@@ -49,7 +49,9 @@ demo: setup
 	@mkdir -p $(OUT)
 	$(PY) -m quadcnn_wb background resources/examples/four_hole.json \
 	    -o $(OUT)/four_hole_background.json --png $(OUT)/four_hole_background.png
-	@echo "wrote $(OUT)/four_hole_background.png and $(OUT)/four_hole_background.json"
+	$(PY) -m quadcnn_wb field resources/examples/four_hole.json \
+	    -o $(OUT)/four_hole_field.json --png $(OUT)/four_hole_field.png
+	@echo "wrote $(OUT)/four_hole_background.png and $(OUT)/four_hole_field.png (+ .json)"
 
 lint: setup
 	$(VENV)/bin/ruff check .
@@ -60,6 +62,7 @@ test: setup lint
 # Speed figures (not part of the test suite).
 bench: setup
 	$(PY) -m quadcnn_wb.bench.background_speed
+	$(PY) -m quadcnn_wb.bench.field_speed
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache

@@ -13,6 +13,7 @@ from pathlib import Path
 from .core.atomic import write_json_atomic
 from .core.background import BackgroundMeshError, background_mesh
 from .core.domain import DomainError, load_domain
+from .core.framefield import FieldError
 
 
 class UsageError(Exception):
@@ -45,6 +46,16 @@ def build_parser() -> argparse.ArgumentParser:
     bg.add_argument("-o", "--output", help="write the mesh as JSON (DESIGN.md 'background')")
     bg.add_argument("--png", help="write a picture of the mesh, boundary and corners")
     bg.set_defaults(run=_run_background)
+
+    fd = commands.add_parser("field", help="cross field, singular points, streamlines, labels")
+    fd.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
+    fd.add_argument("--nodes", type=_positive_int, default=2048,
+                    help="background mesh node count (default 2048)")
+    fd.add_argument("-o", "--output", help="write frames, singularities, streamlines and "
+                    "labels as JSON (DESIGN.md 'field')")
+    fd.add_argument("--png", help="write a picture: crosses, singular points, streamlines, "
+                    "label-1 vectors")
+    fd.set_defaults(run=_run_field)
     return parser
 
 
@@ -74,11 +85,30 @@ def _run_background(args) -> None:
           f"{len(mesh.boundary_nodes)} on the boundary, {len(mesh.corner_nodes)} corners")
 
 
+def _run_field(args) -> None:
+    from .core.reference import numerical_reference
+
+    out = _check_output(args.output, {".json"})
+    png = _check_output(args.png, {".png"})
+    ref = numerical_reference(load_domain(args.input), nodes=args.nodes)
+    if out:
+        write_json_atomic(out, ref.to_json())
+    if png:
+        from .viz.field_plot import plot_field
+
+        plot_field(ref.domain, ref.mesh, ref.field, ref.streamlines, png, labels=ref.labels)
+    counts = ref.field.valences()
+    capped = sum(line.capped for line in ref.streamlines)
+    print(f"{ref.mesh.n_nodes} nodes, {counts[3]} valence-3 and {counts[5]} valence-5 singular "
+          f"points, {len(ref.field.corner_sources)} concave corners, {len(ref.streamlines)} "
+          f"streamlines ({capped} capped), {int(ref.labels.sum())} label-1 vectors")
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         args.run(args)
-    except (DomainError, BackgroundMeshError, UsageError, OSError) as exc:
+    except (DomainError, BackgroundMeshError, FieldError, UsageError, OSError) as exc:
         message = " ".join(str(exc).split())
         print(f"error: {message}", file=sys.stderr)
         return 2

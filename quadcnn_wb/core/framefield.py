@@ -22,6 +22,10 @@ from scipy.sparse.linalg import splu
 from .background import BackgroundMesh
 
 
+class FieldError(RuntimeError):
+    """The field has a zero that is not a simple valence-3 or valence-5 point."""
+
+
 @dataclass(frozen=True)
 class Singularity:
     xy: np.ndarray  # position inside its triangle (the zero of the linear interpolant)
@@ -176,10 +180,14 @@ def _singularity(mesh, z, tri: int, winding: int, patch) -> Singularity:
         xy = _clamp_into_triangle(xy, corners)
     valence = 4 - winding
     if valence not in (3, 5):
-        raise ValueError(f"singular point of valence {valence} in triangle {tri}; the field "
-                         "has a higher-order zero")
+        raise FieldError(f"singular point of valence {valence} near {_fmt(xy)}: the cross "
+                         "field has a higher-order zero there (try another --nodes)")
     return Singularity(xy=xy, valence=valence, triangle=tri,
                        directions=separatrix_directions(zx, zy, valence))
+
+
+def _fmt(p) -> str:
+    return f"({p[0]:.6g}, {p[1]:.6g})"
 
 
 def _inside_triangle(p, corners, tol=1e-12) -> bool:

@@ -182,8 +182,8 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
         dist, idx = boundary.tree.query(path)
         m = int(np.argmin(dist[len(path) // 4:]) + len(path) // 4)
         node = int(boundary.boundary_nodes[idx[m]])
-        li, si, t = int(boundary.loop[node]), int(boundary.segment[node]), float(boundary.param[node])
-        end, xy = boundary.endpoint(li, si, t, h)
+        end, xy = boundary.endpoint(int(boundary.loop[node]), int(boundary.segment[node]),
+                                    float(boundary.param[node]), h)
         paths[i] = list(path[: m + 1]) + [xy]
         ends[i] = end
         capped[i] = True

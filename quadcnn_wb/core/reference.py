@@ -1,0 +1,61 @@
+"""The numerical reference for one domain: background mesh, cross field, singular points,
+traced streamlines and the paper's labels, with the time each stage took.
+
+The `field` command, the benchmarks and (later) dataset generation all need exactly this
+bundle, so it is assembled in one place.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .background import BackgroundMesh, background_mesh
+from .domain import Domain
+from .framefield import FrameField, compute_frame_field
+from .labels import frame_labels
+from .tracing import trace_streamlines
+
+
+@dataclass(frozen=True)
+class Reference:
+    domain: Domain
+    mesh: BackgroundMesh
+    field: FrameField
+    streamlines: tuple
+    labels: np.ndarray  # (N, 2) int8
+    timings: dict  # stage -> seconds
+
+    def to_json(self) -> dict:
+        """The `field` output of DESIGN.md (plus where each streamline starts and ends)."""
+        out = self.mesh.to_json()
+        out["frames"] = self.field.frames.tolist()
+        out["singularities"] = [{"xy": s.xy.tolist(), "valence": s.valence}
+                                for s in self.field.singularities]
+        out["streamlines"] = [line.points.tolist() for line in self.streamlines]
+        out["streamline_ends"] = [{"start": line.start.to_json(), "end": line.end.to_json(),
+                                   "capped": line.capped} for line in self.streamlines]
+        out["labels"] = self.labels.tolist()
+        return out
+
+
+def numerical_reference(domain: Domain, nodes: int = 2048,
+                        mesh: BackgroundMesh | None = None) -> Reference:
+    timings = {}
+    clock = time.perf_counter()
+    if mesh is None:
+        mesh = background_mesh(domain, nodes=nodes)
+        timings["background"] = time.perf_counter() - clock
+        clock = time.perf_counter()
+    field = compute_frame_field(mesh)
+    timings["field"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    streamlines = trace_streamlines(domain, mesh, field)
+    timings["tracing"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    labels = frame_labels(mesh, field.frames, streamlines)
+    timings["labels"] = time.perf_counter() - clock
+    timings["total"] = sum(timings.values())
+    return Reference(domain, mesh, field, streamlines, labels, timings)
