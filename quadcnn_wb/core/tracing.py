@@ -153,6 +153,7 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
         return _rotate_to(np.angle(zc) / 4.0, d), np.abs(zc)
 
     cur_dir = dirs.copy()
+    prev = starts.copy()
     for _ in range(max_steps):
         if not len(active):
             break
@@ -168,13 +169,14 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
         tn, bn, en = walker.locate(tri[active], new)
         tri[active], bary[active], exit_edge[active] = tn, bn, en
         old = pos[active].copy()
+        prev[active] = old
         pos[active] = new
         cur_dir[active] = d2
         travelled[active] += step
         for k, i in enumerate(active):
             paths[i].append(new[k])
         still = _finish_exits(active, tri, exit_edge, old, pos, paths, ends, mesh, boundary, h)
-        still = _finish_snaps(still, pos, cur_dir, travelled, origin, targets, target_kind,
+        still = _finish_snaps(still, pos, prev, travelled, origin, targets, target_kind,
                               field_, paths, ends, h)
         active = still
     for i in active:  # never ended: cap at the point nearest to the boundary
@@ -262,13 +264,19 @@ def _segment_param(p0, p1, a, b) -> float:
     return min(1.0, max(0.0, s))
 
 
-def _finish_snaps(active, pos, cur_dir, travelled, origin, targets, target_kind, field_,
+def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, field_,
                   paths, ends, h):
-    """End streamlines that reach a singular point or a concave corner."""
+    """End streamlines that reach a singular point or a concave corner.
+
+    Only a streamline that is closing in on the target snaps: one leaving a singular point
+    that happens to sit next to another must not end on it at once.
+    """
     if not len(active) or not len(targets):
         return active
     p = pos[active]
     dist = np.hypot(p[:, None, 0] - targets[None, :, 0], p[:, None, 1] - targets[None, :, 1])
+    q = prev[active]
+    before = np.hypot(q[:, None, 0] - targets[None, :, 0], q[:, None, 1] - targets[None, :, 1])
     keep = []
     for k, i in enumerate(active):
         order = np.argsort(dist[k])
@@ -276,6 +284,8 @@ def _finish_snaps(active, pos, cur_dir, travelled, origin, targets, target_kind,
         for j in order[:3]:
             if dist[k, j] > SNAP * h:
                 break
+            if dist[k, j] >= before[k, j]:
+                continue
             target = target_kind[j]
             if target == origin[i] and (target.kind == "corner" or travelled[i] < 3 * SNAP * h):
                 continue

@@ -1,0 +1,77 @@
+"""Domain JSON builders for the tests' own shapes (beyond ../shared/examples)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def rect(w, h, x0=0.0, y0=0.0):
+    p = [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
+    return [{"line": [p[i], p[(i + 1) % 4]]} for i in range(4)]
+
+
+def circle(cx, cy, r):
+    return [{"circle": {"center": [cx, cy], "radius": r}}]
+
+
+def polygon(points):
+    return [{"line": [list(points[i]), list(points[(i + 1) % len(points)])]}
+            for i in range(len(points))]
+
+
+def regular_polygon(n, r=1.0):
+    return polygon([[r * math.cos(a), r * math.sin(a)]
+                    for a in np.linspace(0, 2 * math.pi, n + 1)[:-1]])
+
+
+def stadium():
+    return [{"line": [[0, 0], [2, 0]]}, {"arc": [[2, 0], [3, 1], [2, 2]]},
+            {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]
+
+
+def transform_domain(data, matrix, shift=(0.0, 0.0)):
+    """Apply p -> matrix @ p + shift to every point and radius of a Domain JSON dict."""
+    m = np.asarray(matrix, dtype=float)
+    scale = math.sqrt(abs(np.linalg.det(m)))
+
+    def tp(p):
+        return (m @ np.asarray(p, dtype=float) + shift).tolist()
+
+    loops = []
+    for loop in data["loops"]:
+        out = []
+        for seg in loop:
+            (kind, value), = seg.items()
+            if kind == "circle":
+                out.append({"circle": {"center": tp(value["center"]),
+                                       "radius": value["radius"] * scale}})
+            else:
+                out.append({kind: [tp(p) for p in value]})
+        loops.append(out)
+    return {"loops": loops}
+
+
+def rotation(degrees, scale=1.0, mirror=False):
+    a = math.radians(degrees)
+    m = scale * np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return m @ np.diag([-1.0, 1.0]) if mirror else m
+
+
+# name -> (loops, expected valence-3 count, expected valence-5 count)
+OWN_SHAPES = {
+    "disk": ([circle(0, 0, 1)], 4, 0),
+    "annulus": ([circle(0, 0, 1), circle(0.1, 0, 0.4)], 0, 0),
+    "triangle": ([polygon([[0, 0], [1, 0], [0.5, 0.9]])], 1, 0),
+    "plate, 1 hole": ([rect(3, 2), circle(1.5, 1, 0.4)], 0, 4),
+    "plate, 2 holes": ([rect(3, 2), circle(0.8, 1, 0.3), circle(2.2, 1, 0.3)], 0, 8),
+    "plate, 3 holes": ([rect(4, 2), circle(0.8, 1, 0.3), circle(2, 1, 0.3),
+                        circle(3.2, 1.1, 0.3)], 0, 12),
+    "stadium": ([stadium()], 4, 0),
+    "pentagon": ([regular_polygon(5)], 0, 1),
+    "hexagon": ([regular_polygon(6)], 0, 2),
+    "square with square hole": ([rect(3, 3), rect(1, 1, 1, 1)], 0, 0),
+    "T shape": ([polygon([[0, 0], [1, 0], [1, 2], [2, 2], [2, 3], [-1, 3], [-1, 2],
+                          [0, 2]])], 0, 0),
+}

@@ -1,0 +1,108 @@
+"""Cross field and singular points: alignment, unit frames, exactly the minimal singularities."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from conftest import SHARED_EXAMPLES
+from shapes import OWN_SHAPES, rotation, transform_domain
+
+from quadcnn_wb.core.background import background_mesh
+from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.framefield import compute_frame_field
+
+EXPECTED = json.loads((SHARED_EXAMPLES / "expected_singularities.json").read_text())
+
+
+def field_of(domain, nodes=2048):
+    mesh = background_mesh(domain, nodes=nodes)
+    return mesh, compute_frame_field(mesh)
+
+
+def poincare_hopf_holds(mesh, field, holes) -> bool:
+    total = sum((4 - s.valence) / 4 for s in field.singularities)
+    total += sum((2 - round(a / (math.pi / 2))) / 4 for a in mesh.corner_angles)
+    return abs(total - (1 - holes)) < 1e-9
+
+
+def test_shared_examples_have_exactly_the_expected_singularities(example_path):
+    domain = load_domain(example_path)
+    mesh, field = field_of(domain)
+    expected = EXPECTED[example_path.stem]
+    assert field.valences() == {3: expected["val3"], 5: expected["val5"]}
+    assert poincare_hopf_holds(mesh, field, domain.holes)
+
+
+@pytest.mark.parametrize("name", OWN_SHAPES)
+def test_own_shapes_have_the_minimal_singularities(name):
+    loops, val3, val5 = OWN_SHAPES[name]
+    domain = domain_from_json({"loops": loops})
+    mesh, field = field_of(domain)
+    assert field.valences() == {3: val3, 5: val5}
+    assert poincare_hopf_holds(mesh, field, domain.holes)
+
+
+@pytest.mark.parametrize("matrix", [rotation(30), rotation(-117, scale=1e3),
+                                    rotation(0, mirror=True), rotation(71, 1e-4, mirror=True)],
+                         ids=["rotated", "rotated+scaled", "mirrored", "all"])
+@pytest.mark.parametrize("name", ["four_hole", "semicircle", "concave", "plate_hole"])
+def test_counts_survive_rotation_scaling_and_mirroring(name, matrix):
+    data = json.loads((SHARED_EXAMPLES / f"{name}.json").read_text())
+    moved = domain_from_json(transform_domain(data, matrix, shift=(123.0, -45.0)))
+    _, field = field_of(moved)
+    assert field.valences() == {3: EXPECTED[name]["val3"], 5: EXPECTED[name]["val5"]}
+
+
+def test_frames_are_unit_and_perpendicular(example_path):
+    _, field = field_of(load_domain(example_path))
+    f = field.frames
+    assert np.allclose(np.hypot(f[:, 0], f[:, 1]), 1.0, atol=1e-14)
+    assert np.allclose(np.hypot(f[:, 2], f[:, 3]), 1.0, atol=1e-14)
+    assert np.allclose(f[:, 0] * f[:, 2] + f[:, 1] * f[:, 3], 0.0, atol=1e-14)
+
+
+def test_field_is_aligned_with_the_boundary(example_path):
+    mesh, field = field_of(load_domain(example_path))
+    f = field.frames[mesh.boundary_nodes]
+    t = mesh.boundary_tangent
+    # One of the two frame vectors is parallel to the tangent (the other is then normal).
+    off = np.minimum(np.abs(f[:, 0] * t[:, 1] - f[:, 1] * t[:, 0]),
+                     np.abs(f[:, 2] * t[:, 1] - f[:, 3] * t[:, 0]))
+    assert off.max() < 1e-9
+    # Right-angle corners hold both of their edges exactly.
+    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    for node, t_in in zip(mesh.corner_nodes, mesh.corner_tangents_in):
+        v = field.frames[node]
+        assert min(abs(v[0] * t_in[1] - v[1] * t_in[0]),
+                   abs(v[2] * t_in[1] - v[3] * t_in[0])) < 1e-9, position[int(node)]
+
+
+def test_singular_points_lie_in_their_triangle_with_spread_directions(example_path):
+    mesh, field = field_of(load_domain(example_path))
+    for s in field.singularities:
+        a, b, c = mesh.nodes[mesh.triangles[s.triangle]]
+        u, v = np.linalg.solve(np.array([b - a, c - a]).T, s.xy - a)
+        assert u >= -1e-9 and v >= -1e-9 and u + v <= 1 + 1e-9
+        assert len(s.directions) == s.valence
+        angles = np.sort(np.arctan2(s.directions[:, 1], s.directions[:, 0]))
+        gaps = np.diff(np.concatenate([angles, [angles[0] + 2 * math.pi]]))
+        assert gaps.min() > math.radians(30)  # 3 or 5 distinct directions, not a cluster
+
+
+def test_concave_corners_are_streamline_sources():
+    for name, count in (("l_shape", 1), ("concave", 2), ("four_hole", 0)):
+        _, field = field_of(load_domain(SHARED_EXAMPLES / f"{name}.json"))
+        assert len(field.corner_sources) == count
+        for source in field.corner_sources:
+            assert source.angle == pytest.approx(1.5 * math.pi)
+            assert len(source.directions) == 2
+
+
+def test_field_is_deterministic():
+    domain = load_domain(SHARED_EXAMPLES / "four_hole.json")
+    (_, f1), (_, f2) = field_of(domain), field_of(domain)
+    assert np.array_equal(f1.z, f2.z)
+    assert [s.xy.tolist() for s in f1.singularities] == [s.xy.tolist() for s in f2.singularities]
