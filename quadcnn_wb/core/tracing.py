@@ -27,21 +27,27 @@ SNAP = 1.0  # snapping radius around singular points and concave corners, in ele
 CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the corner
 MAX_LENGTH = 4.0  # streamlines longer than this many domain diagonals are capped
 SNAP_ANGLE = math.radians(45)  # an approach must be this close to a separatrix to snap
-DUPLICATE = 1.0  # two separatrices joining the same points this close (in sizes) are one
+MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
 
 
 @dataclass(frozen=True)
 class Endpoint:
-    kind: str  # "singularity", "corner" or "boundary"
-    index: int = -1  # singularity index, or background node of the corner
+    kind: str  # "singularity", "corner", "boundary" or "streamline" (a T-junction)
+    index: int = -1  # singularity index, background node of the corner, or streamline index
     loop: int = -1  # for corner and boundary ends: where on the boundary
     segment: int = -1
     param: float = -1.0
+    branch: int = -1  # at a singular point: which of its separatrix directions
+
+    def same_place(self, other) -> bool:
+        return (self.kind, self.index) == (other.kind, other.index)
 
     def to_json(self) -> dict:
         out = {"kind": self.kind}
         if self.index >= 0:
             out["index"] = self.index
+        if self.branch >= 0:
+            out["branch"] = self.branch
         if self.loop >= 0:
             out.update(loop=self.loop, segment=self.segment, param=self.param)
         return out
@@ -191,14 +197,14 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
         capped[i] = True
     lines = [Streamline(points=np.array(paths[i]), start=origin[i], end=ends[i],
                         capped=capped[i], start_direction=dirs[i]) for i in range(len(sources))]
-    return tuple(_drop_duplicates(lines, h))
+    return tuple(_one_line_per_separatrix(lines, h))
 
 
 def _sources(mesh, field_, walker, h):
     out = []
     for si, sing in enumerate(field_.singularities):
-        for d in sing.directions:
-            out.append((sing.xy, d, sing.triangle, Endpoint("singularity", si)))
+        for k, d in enumerate(sing.directions):
+            out.append((sing.xy, d, sing.triangle, Endpoint("singularity", si, branch=k)))
     incident = {}
     for t, tri in enumerate(mesh.triangles):
         for n in tri:
@@ -287,13 +293,16 @@ def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, fi
             if dist[k, j] >= before[k, j]:
                 continue
             target = target_kind[j]
-            if target == origin[i] and (target.kind == "corner" or travelled[i] < 3 * SNAP * h):
+            if target.same_place(origin[i]) and (target.kind == "corner"
+                                                 or travelled[i] < 3 * SNAP * h):
                 continue
             if target.kind == "singularity":
                 radial = (p[k] - targets[j]) / max(dist[k, j], 1e-300)
                 seps = field_.singularities[target.index].directions
-                if np.max(seps @ radial) < math.cos(SNAP_ANGLE):
+                alignment = seps @ radial
+                if np.max(alignment) < math.cos(SNAP_ANGLE):
                     continue
+                target = Endpoint("singularity", target.index, branch=int(np.argmax(alignment)))
             paths[i][-1] = targets[j].copy()
             ends[i] = target
             done = True
@@ -303,20 +312,113 @@ def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, fi
     return np.array(keep, dtype=np.int64)
 
 
-def _drop_duplicates(lines, h):
-    """Keep one of two separatrices that join the same two points along the same path."""
-    kept = []
+def _one_line_per_separatrix(lines, h):
+    """One streamline per separatrix.
+
+    A streamline from singular point a that arrives at b along b's separatrix k *is* that
+    separatrix of b, so b's own trace of k (which may have wandered elsewhere: tracing
+    leaves a singular point less reliably than it arrives) must go.  Each line claims the
+    separatrix slots at its two ends; shorter lines claim first, as a short connection
+    between two singular points is the most trustworthy trace.  A line whose start slot
+    is still free but whose end slot is taken still has to stay (its own separatrix would
+    be missing otherwise): it joins the line holding that slot where it meets it, as a
+    T-junction, instead of piling a second line onto the same separatrix.
+    """
+    def slot(e):
+        return (e.index, e.branch) if e.kind == "singularity" and e.branch >= 0 else None
+
+    lines = _arrival_branches(lines, h)
+    order = sorted(range(len(lines)), key=lambda i: lines[i].length)
+    owner, keep, joins = {}, set(), {}
+    for i in order:
+        mine = {slot(lines[i].start), slot(lines[i].end)} - {None}
+        if not any(m in owner for m in mine):
+            keep.add(i)
+            owner.update({m: i for m in mine})
+    for i in order:
+        start, end = slot(lines[i].start), slot(lines[i].end)
+        if i in keep or lines[i].start.kind == "corner":
+            keep.add(i)
+            continue
+        if start is not None and start not in owner:
+            keep.add(i)
+            owner[start] = i
+            if end is not None and end in owner:
+                joins[i] = owner[end]
+    final = sorted(keep)
+    position = {i: k for k, i in enumerate(final)}
+    out = []
+    for i in final:
+        line = lines[i]
+        if i in joins:
+            line = _join(line, lines[joins[i]], position[joins[i]], h)
+        out.append(line)
+    return out
+
+
+def _arrival_branches(lines, h):
+    """Which separatrix of its end point each arriving streamline runs along.
+
+    The direction of arrival alone is ambiguous next to a singular point (the field turns
+    fast there), so compare the arriving line with the point's own traced separatrices
+    over the first few element sizes: it arrives along the one it lies closest to.
+    """
+    leaving = {(ln.start.index, ln.start.branch): ln for ln in lines
+               if ln.start.kind == "singularity"}
+    out = []
     for line in lines:
-        duplicate = False
-        for other in kept:
-            if {line.start, line.end} == {other.start, other.end} and line.start != line.end:
-                if _hausdorff(line.points, other.points) < DUPLICATE * h:
-                    duplicate = True
-                    break
-        if not duplicate:
-            kept.append(line)
-    return kept
+        end = line.end
+        if end.kind != "singularity":
+            out.append(line)
+            continue
+        tree = cKDTree(_densify(line.points, 0.25 * h))
+        best, best_dist = end.branch, np.inf
+        for (index, branch), own in leaving.items():
+            if index != end.index:
+                continue
+            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= 3 * h]
+            if len(near) < 2:
+                continue
+            d = float(tree.query(near[1:])[0].mean())
+            if d < best_dist:
+                best, best_dist = branch, d
+        out.append(Streamline(points=line.points, start=line.start,
+                              end=Endpoint("singularity", end.index, branch=best),
+                              capped=line.capped, start_direction=line.start_direction))
+    return out
 
 
-def _hausdorff(a: np.ndarray, b: np.ndarray) -> float:
-    return max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max())
+def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
+    """End ``line`` on ``other`` where it first comes within MERGE sizes of it."""
+    dense = _densify(other.points, 0.25 * h)
+    dist = cKDTree(dense).query(line.points)[0]
+    close = np.nonzero(dist <= MERGE * h)[0]
+    close = close[close > 0]
+    if not len(close):
+        return line
+    head = int(close[0])
+    point, param = _nearest_on_polyline(other.points, line.points[head])
+    return Streamline(points=np.vstack([line.points[:head], point]), start=line.start,
+                      end=Endpoint("streamline", other_index, param=param),
+                      capped=line.capped, start_direction=line.start_direction)
+
+
+def _densify(points, spacing):
+    seg = np.diff(points, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / spacing).astype(int))
+    parts = [points[i] + np.outer(np.arange(k) / k, seg[i]) for i, k in enumerate(n)]
+    return np.vstack(parts + [points[-1:]])
+
+
+def _nearest_on_polyline(points, p):
+    """Closest point to p on the polyline, and its arc-length fraction along it."""
+    a, b = points[:-1], points[1:]
+    d = b - a
+    len2 = np.maximum((d * d).sum(axis=1), 1e-300)
+    t = np.clip(((p - a) * d).sum(axis=1) / len2, 0.0, 1.0)
+    q = a + t[:, None] * d
+    k = int(np.argmin(np.hypot(*(q - p).T)))
+    seglen = np.sqrt(len2)
+    total = float(seglen.sum())
+    along = float(seglen[:k].sum() + t[k] * seglen[k])
+    return q[k], along / total if total > 0 else 0.0
