@@ -1,0 +1,135 @@
+"""Reference streamlines and labels: where they end, one per separatrix, labels along them."""
+
+from __future__ import annotations
+
+import functools
+from collections import Counter
+
+import numpy as np
+import pytest
+from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
+from shapes import OWN_SHAPES
+
+from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.labels import resample
+from quadcnn_wb.core.reference import numerical_reference
+
+CASES = EXAMPLE_NAMES + list(OWN_SHAPES)
+
+
+@functools.cache
+def reference(name):
+    if name in EXAMPLE_NAMES:
+        domain = load_domain(SHARED_EXAMPLES / f"{name}.json")
+    else:
+        domain = domain_from_json({"loops": OWN_SHAPES[name][0]})
+    return numerical_reference(domain)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_every_streamline_ends_exactly_where_its_end_says(name):
+    ref = reference(name)
+    sings = ref.field.singularities
+    for line in ref.streamlines:
+        assert not line.capped
+        first, last = line.points[0], line.points[-1]
+        if line.start.kind == "singularity":
+            assert np.array_equal(first, sings[line.start.index].xy)
+        else:
+            assert line.start.kind == "corner"
+            assert np.array_equal(first, ref.mesh.nodes[line.start.index])
+        end = line.end
+        if end.kind == "singularity":
+            assert np.array_equal(last, sings[end.index].xy)
+        elif end.kind in ("boundary", "corner"):
+            curve = ref.domain.loops[end.loop][end.segment]
+            assert np.array_equal(last, curve.point(end.param))
+            if end.kind == "corner":
+                assert np.array_equal(last, ref.mesh.nodes[end.index])
+        else:
+            assert end.kind == "streamline"
+            other = ref.streamlines[end.index].points
+            seg_dist = _distance_to_polyline(last, other)
+            assert seg_dist < 1e-9 * ref.domain.size
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_each_singular_point_has_one_streamline_per_separatrix(name):
+    ref = reference(name)
+    attached = Counter()
+    for line in ref.streamlines:
+        for end in (line.start, line.end):
+            if end.kind == "singularity":
+                attached[end.index] += 1
+    for i, sing in enumerate(ref.field.singularities):
+        assert attached[i] == sing.valence, (i, attached[i], sing.valence)
+    for corner in ref.field.corner_sources:
+        starts = sum(1 for line in ref.streamlines
+                     if line.start.kind == "corner" and line.start.index == corner.node)
+        assert starts == len(corner.directions)
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_streamlines_follow_the_field(name):
+    ref = reference(name)
+    theta = ref.field.theta
+    walker_nodes = ref.mesh.nodes
+    for line in ref.streamlines:
+        pts, dirs = resample(line.points, ref.mesh.element_size / 2)
+        # Away from the ends, the line's direction is within 20° of the nearest node's cross.
+        inner = slice(3, len(pts) - 3)
+        nearest = np.argmin(((pts[inner, None, :] - walker_nodes[None]) ** 2).sum(-1), axis=1)
+        ang = np.arctan2(dirs[inner, 1], dirs[inner, 0]) - theta[nearest]
+        off = np.abs((ang + np.pi / 4) % (np.pi / 2) - np.pi / 4)
+        assert np.degrees(np.percentile(off, 95)) < 20 if len(off) else True
+
+
+def test_l_shape_streamlines_continue_the_concave_edges():
+    ref = reference("l_shape")
+    ends = sorted(tuple(np.round(line.points[-1], 9)) for line in ref.streamlines)
+    assert ends == [(0.0, 1.0), (1.0, 0.0)]  # straight to the opposite sides
+    for line in ref.streamlines:
+        assert np.max(np.abs(line.points - line.points[0]).min(axis=1)) < 1e-6
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_labels_present_along_every_streamline(name):
+    ref = reference(name)
+    labelled = ref.mesh.nodes[np.any(ref.labels == 1, axis=1)]
+    h = ref.mesh.element_size
+    for line in ref.streamlines:
+        pts, _ = resample(line.points, h / 4)
+        d = np.sqrt(((pts[:, None, :] - labelled[None]) ** 2).sum(-1)).min(axis=1)
+        assert d.max() < 1.2 * h
+
+
+def test_labelled_vectors_are_the_ones_along_the_streamline():
+    ref = reference("concave")  # its streamlines are straight and axis-parallel
+    frames = ref.field.frames
+    h = ref.mesh.element_size
+    directions = []
+    for line in ref.streamlines:
+        d = line.points[-1] - line.points[0]
+        directions.append(d / np.hypot(*d))
+    for node, col in zip(*np.nonzero(ref.labels == 1)):
+        v = frames[node, 2 * col: 2 * col + 2]
+        near = [d for line, d in zip(ref.streamlines, directions)
+                if _distance_to_polyline(ref.mesh.nodes[node], line.points) < 1.2 * h]
+        assert near and max(abs(v @ d) for d in near) > 0.99
+    assert set(np.unique(ref.labels)) == {0, 1}
+
+
+def test_reference_is_deterministic():
+    domain = load_domain(SHARED_EXAMPLES / "four_hole.json")
+    a, b = numerical_reference(domain), numerical_reference(domain)
+    assert len(a.streamlines) == len(b.streamlines)
+    for la, lb in zip(a.streamlines, b.streamlines):
+        assert np.array_equal(la.points, lb.points) and la.end == lb.end
+    assert np.array_equal(a.labels, b.labels)
+
+
+def _distance_to_polyline(p, points):
+    a, b = points[:-1], points[1:]
+    d = b - a
+    t = np.clip(((p - a) * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
+    return float(np.hypot(*(a + t[:, None] * d - p).T).min())
