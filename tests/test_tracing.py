@@ -133,3 +133,21 @@ def _distance_to_polyline(p, points):
     d = b - a
     t = np.clip(((p - a) * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
     return float(np.hypot(*(a + t[:, None] * d - p).T).min())
+
+
+def test_streamlines_that_run_too_long_are_capped_onto_the_boundary(monkeypatch):
+    from quadcnn_wb.core import tracing
+    from quadcnn_wb.core.background import background_mesh
+    from quadcnn_wb.core.framefield import compute_frame_field
+
+    domain = load_domain(SHARED_EXAMPLES / "plate_hole.json")
+    mesh = background_mesh(domain)
+    field = compute_frame_field(mesh)
+    monkeypatch.setattr(tracing, "MAX_LENGTH", 0.15)  # shorter than most separatrices
+    lines = tracing.trace_streamlines(domain, mesh, field)
+    capped = [line for line in lines if line.capped]
+    assert capped
+    for line in capped:
+        assert line.end.kind in ("boundary", "corner")
+        curve = domain.loops[line.end.loop][line.end.segment]
+        assert np.array_equal(line.points[-1], curve.point(line.end.param))

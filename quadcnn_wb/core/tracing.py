@@ -214,12 +214,13 @@ def _sources(mesh, field_, walker, h):
         k = position[cs.node]
         corner = Endpoint("corner", cs.node, int(mesh.boundary_loop[k]),
                           int(mesh.boundary_segment[k]), 0.0)
-        for d in cs.directions:
+        for branch, d in enumerate(cs.directions):
             probe = cs.xy + 1e-6 * h * d
             tris = np.array(incident[cs.node])
             b = walker.barycentric(tris, np.repeat(probe[None], len(tris), axis=0))
             t0 = int(tris[np.argmax(b.min(axis=1))])
-            out.append((cs.xy, d, t0, corner))
+            out.append((cs.xy, d, t0, Endpoint(corner.kind, corner.index, corner.loop,
+                                               corner.segment, 0.0, branch)))
     return out
 
 
@@ -325,7 +326,7 @@ def _one_line_per_separatrix(lines, h):
     T-junction, instead of piling a second line onto the same separatrix.
     """
     def slot(e):
-        return (e.index, e.branch) if e.kind == "singularity" and e.branch >= 0 else None
+        return (e.kind, e.index, e.branch) if e.branch >= 0 else None
 
     lines = _arrival_branches(lines, h)
     order = sorted(range(len(lines)), key=lambda i: lines[i].length)
@@ -337,8 +338,7 @@ def _one_line_per_separatrix(lines, h):
             owner.update({m: i for m in mine})
     for i in order:
         start, end = slot(lines[i].start), slot(lines[i].end)
-        if i in keep or lines[i].start.kind == "corner":
-            keep.add(i)
+        if i in keep:
             continue
         if start is not None and start not in owner:
             keep.add(i)
@@ -357,24 +357,24 @@ def _one_line_per_separatrix(lines, h):
 
 
 def _arrival_branches(lines, h):
-    """Which separatrix of its end point each arriving streamline runs along.
+    """Which separatrix of its end point (singular point or concave corner) each arriving
+    streamline runs along.
 
     The direction of arrival alone is ambiguous next to a singular point (the field turns
     fast there), so compare the arriving line with the point's own traced separatrices
     over the first few element sizes: it arrives along the one it lies closest to.
     """
-    leaving = {(ln.start.index, ln.start.branch): ln for ln in lines
-               if ln.start.kind == "singularity"}
+    leaving = {(ln.start.kind, ln.start.index, ln.start.branch): ln for ln in lines}
     out = []
     for line in lines:
         end = line.end
-        if end.kind != "singularity":
-            out.append(line)
+        if not any(key[:2] == (end.kind, end.index) for key in leaving):
+            out.append(line)  # the boundary, or a convex corner: no separatrices there
             continue
         tree = cKDTree(_densify(line.points, 0.25 * h))
         best, best_dist = end.branch, np.inf
-        for (index, branch), own in leaving.items():
-            if index != end.index:
+        for (kind, index, branch), own in leaving.items():
+            if (kind, index) != (end.kind, end.index):
                 continue
             near = own.points[np.hypot(*(own.points - own.points[0]).T) <= 3 * h]
             if len(near) < 2:
@@ -383,7 +383,8 @@ def _arrival_branches(lines, h):
             if d < best_dist:
                 best, best_dist = branch, d
         out.append(Streamline(points=line.points, start=line.start,
-                              end=Endpoint("singularity", end.index, branch=best),
+                              end=Endpoint(end.kind, end.index, end.loop, end.segment,
+                                           end.param, best),
                               capped=line.capped, start_direction=line.start_direction))
     return out
 
