@@ -64,9 +64,9 @@ def test_each_singular_point_has_one_streamline_per_separatrix(name):
     for i, sing in enumerate(ref.field.singularities):
         assert attached[i] == sing.valence, (i, attached[i], sing.valence)
     for corner in ref.field.corner_sources:
-        starts = sum(1 for line in ref.streamlines
-                     if line.start.kind == "corner" and line.start.index == corner.node)
-        assert starts == len(corner.directions)
+        here = sum(1 for line in ref.streamlines for end in (line.start, line.end)
+                   if end.kind == "corner" and end.index == corner.node)
+        assert here == len(corner.directions)
 
 
 @pytest.mark.parametrize("name", EXAMPLE_NAMES)
