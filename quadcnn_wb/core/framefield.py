@@ -220,23 +220,24 @@ def separatrix_directions(zx: complex, zy: complex, valence: int) -> np.ndarray:
     """
     a = 0.5 * (zx - 1j * zy)
     b = 0.5 * (zx + 1j * zy)
-    phi = np.linspace(0.0, 2 * np.pi, 2049)
-    g = a * np.exp(-3j * phi) + b * np.exp(-5j * phi)
-    arg = np.angle(g)
-    roots = []
-    for k in range(len(phi) - 1):
-        if arg[k] == 0.0 or (arg[k] * arg[k + 1] < 0 and abs(arg[k] - arg[k + 1]) < np.pi):
-            lo, hi = phi[k], phi[k + 1]
-            flo = arg[k]
-            for _ in range(40):
-                mid = 0.5 * (lo + hi)
-                fm = np.angle(a * np.exp(-3j * mid) + b * np.exp(-5j * mid))
-                if (fm < 0) == (flo < 0):
-                    lo, flo = mid, fm
-                else:
-                    hi = mid
-            roots.append(0.5 * (lo + hi))
-    roots = np.array(roots)
+
+    def g(phi):
+        return a * np.exp(-3j * phi) + b * np.exp(-5j * phi)
+
+    phi = np.linspace(0.0, 2 * np.pi, 721)
+    val = g(phi)
+    # arg g = 0 where Im g changes sign while Re g > 0; refine all brackets together.
+    k = np.nonzero((np.sign(val.imag[:-1]) != np.sign(val.imag[1:]))
+                   & (val.real[:-1] + val.real[1:] > 0))[0]
+    lo, hi = phi[k], phi[k + 1]
+    flo = val.imag[k]
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        fm = g(mid).imag
+        left = np.sign(fm) == np.sign(flo)
+        lo, flo = np.where(left, mid, lo), np.where(left, fm, flo)
+        hi = np.where(left, hi, mid)
+    roots = 0.5 * (lo + hi)
     if len(roots) != valence:
         # Degenerate gradient: fall back to evenly spaced directions from the strongest root.
         start = roots[0] if len(roots) else 0.0
