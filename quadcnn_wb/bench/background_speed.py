@@ -8,18 +8,14 @@ search settled on, i.e. what meshing costs when the right size is known in advan
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
-from pathlib import Path
 
 import gmsh
 
 from ..core.background import GMSH_ALGORITHM, _build_geometry, background_mesh
-from ..core.domain import load_domain
 from ..core.gmsh_session import gmsh_session
-
-EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+from .common import bundled_examples, parse_options
 
 
 def bare_gmsh_seconds(domain, h: float) -> float:
@@ -35,14 +31,10 @@ def bare_gmsh_seconds(domain, h: float) -> float:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--nodes", type=int, default=2048)
-    parser.add_argument("--repeat", type=int, default=15)
-    args = parser.parse_args(argv)
+    args = parse_options(__doc__, argv, repeat=15)
     print(f"{'example':<12} {'nodes':>6} {'ours median':>12} {'ours max':>9} "
           f"{'bare gmsh':>10} {'ratio':>6}")
-    for path in sorted(EXAMPLES.glob("*.json")):
-        domain = load_domain(path)
+    for name, domain in bundled_examples():
         ours, peer, mesh = [], [], None
         for _ in range(args.repeat):
             start = time.perf_counter()
@@ -50,7 +42,7 @@ def main(argv=None) -> int:
             ours.append(time.perf_counter() - start)
             peer.append(bare_gmsh_seconds(domain, mesh.element_size / domain.size))
         med, bare = statistics.median(ours), statistics.median(peer)
-        print(f"{path.stem:<12} {mesh.n_nodes:>6} {med * 1e3:>10.1f}ms {max(ours) * 1e3:>7.1f}ms "
+        print(f"{name:<12} {mesh.n_nodes:>6} {med * 1e3:>10.1f}ms {max(ours) * 1e3:>7.1f}ms "
               f"{bare * 1e3:>8.1f}ms {med / bare:>6.2f}")
     return 0
 

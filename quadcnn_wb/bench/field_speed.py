@@ -8,33 +8,26 @@ for numerical tracing on its four-hole model (1.644 s) and the issue's goals
 
 from __future__ import annotations
 
-import argparse
 import statistics
-from pathlib import Path
 
 from ..core.background import background_mesh
-from ..core.domain import load_domain
 from ..core.reference import numerical_reference
+from .common import bundled_examples, parse_options
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 PAPER_TRACING_SECONDS = 1.644
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--nodes", type=int, default=2048)
-    parser.add_argument("--repeat", type=int, default=9)
-    args = parser.parse_args(argv)
+    args = parse_options(__doc__, argv, repeat=9)
     print(f"{'example':<12} {'nodes':>6} {'sing':>5} {'lines':>6} {'field+sing':>11} "
           f"{'tracing':>9} {'labels':>8} {'paper/ours tracing':>19}")
-    for path in sorted(EXAMPLES.glob("*.json")):
-        domain = load_domain(path)
+    for name, domain in bundled_examples():
         mesh = background_mesh(domain, nodes=args.nodes)
         runs = [numerical_reference(domain, mesh=mesh) for _ in range(args.repeat)]
         med = {k: statistics.median(r.timings[k] for r in runs)
                for k in ("field", "tracing", "labels")}
         ref = runs[0]
-        print(f"{path.stem:<12} {mesh.n_nodes:>6} {len(ref.field.singularities):>5} "
+        print(f"{name:<12} {mesh.n_nodes:>6} {len(ref.field.singularities):>5} "
               f"{len(ref.streamlines):>6} {med['field'] * 1e3:>9.1f}ms "
               f"{med['tracing'] * 1e3:>7.1f}ms {med['labels'] * 1e3:>6.1f}ms "
               f"{PAPER_TRACING_SECONDS / med['tracing']:>18.1f}x")

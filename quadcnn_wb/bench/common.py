@@ -1,0 +1,23 @@
+"""What every benchmark shares: its options and the bundled examples it runs on."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..core.domain import load_domain
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+
+
+def parse_options(doc: str, argv, repeat: int):
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--nodes", type=int, default=2048)
+    parser.add_argument("--repeat", type=int, default=repeat)
+    return parser.parse_args(argv)
+
+
+def bundled_examples():
+    """(name, domain) for every bundled example, in name order."""
+    for path in sorted(EXAMPLES.glob("*.json")):
+        yield path.stem, load_domain(path)
