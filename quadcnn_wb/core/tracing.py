@@ -127,13 +127,21 @@ def _rotate_to(theta: np.ndarray, d: np.ndarray) -> np.ndarray:
 
 
 def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) -> tuple:
-    h = mesh.element_size
-    step = STEP * h
+    """Every separatrix and concave-corner streamline, one line per separatrix."""
     walker = MeshWalker(mesh.nodes, mesh.triangles)
-    boundary = _BoundaryIndex(domain, mesh)
-    sources = _sources(mesh, field_, walker, h)
+    sources = _sources(mesh, field_, walker, mesh.element_size)
     if not sources:
         return ()
+    lines = integrate(domain, mesh, field_, sources, walker)
+    return tuple(_one_line_per_separatrix(lines, mesh.element_size))
+
+
+def integrate(domain, mesh, field_, sources, walker=None) -> list:
+    """Trace from each (start xy, unit direction, start triangle, start Endpoint) source."""
+    h = mesh.element_size
+    step = STEP * h
+    walker = walker or MeshWalker(mesh.nodes, mesh.triangles)
+    boundary = _BoundaryIndex(domain, mesh)
     z = field_.z
     starts = np.array([s[0] for s in sources])
     dirs = np.array([s[1] for s in sources])
@@ -195,9 +203,8 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
         paths[i] = list(path[: m + 1]) + [xy]
         ends[i] = end
         capped[i] = True
-    lines = [Streamline(points=np.array(paths[i]), start=origin[i], end=ends[i],
-                        capped=capped[i], start_direction=dirs[i]) for i in range(len(sources))]
-    return tuple(_one_line_per_separatrix(lines, h))
+    return [Streamline(points=np.array(paths[i]), start=origin[i], end=ends[i],
+                       capped=capped[i], start_direction=dirs[i]) for i in range(len(sources))]
 
 
 def _sources(mesh, field_, walker, h):

@@ -1,0 +1,362 @@
+"""Block partition: the planar arrangement of boundary curves and streamlines, and its
+faces checked to be four-sided blocks.
+
+Vertices are the loop vertices, singular points, streamline ends on the boundary, crossings
+of streamlines and T-junctions; edges are the boundary and streamline pieces between them
+(boundary pieces remember their exact curve stretch, so mesh nodes can go on the true
+curve).  Faces are walked with half-edges, the face on the left of each.  A block corner
+is a vertex where the face's boundary turns by more than 45° (about 90° on a field-aligned
+partition); a straight-through vertex (a T-junction, a streamline foot) only splits a side
+into several edges.  A loop that no streamline reaches (an annulus's hole) first gets a
+cut along a field line, so every face is a disk.  Anything else than four corners and no
+reflex turn is refused: a PartitionError, never a silent bad mesh.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
+
+
+class PartitionError(RuntimeError):
+    """The streamlines do not cut the domain into four-sided blocks."""
+
+
+@dataclass(frozen=True)
+class BoundaryPiece:
+    """Exact stretch of one boundary curve: parameter t0 to t1 of loops[loop][segment]."""
+
+    loop: int
+    segment: int
+    t0: float
+    t1: float
+
+
+@dataclass
+class Edge:
+    points: np.ndarray  # polyline from vertex a to vertex b
+    a: int
+    b: int
+    pieces: tuple = ()  # BoundaryPiece stretches, in order, for boundary edges
+    streamline: int = -1  # source streamline index for interior edges
+
+    @property
+    def is_boundary(self) -> bool:
+        return bool(self.pieces)
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+@dataclass(frozen=True)
+class Block:
+    corners: tuple  # four vertex ids, counter-clockwise
+    sides: tuple  # four tuples of (edge id, forward) from corner k to corner k+1
+
+
+@dataclass
+class Partition:
+    vertices: np.ndarray  # (V, 2)
+    edges: list
+    blocks: list
+    cuts: list  # extra polylines added so that every face is a disk
+
+    def edge_points(self, e: int, forward: bool) -> np.ndarray:
+        pts = self.edges[e].points
+        return pts if forward else pts[::-1]
+
+
+# ----------------------------------------------------------------------------------------
+# Building the arrangement
+
+
+class _Vertices:
+    """Vertex ids by key, merging keys that name the same place."""
+
+    def __init__(self):
+        self.xy: list = []
+        self.by_key: dict = {}
+
+    def get(self, key, xy) -> int:
+        if key not in self.by_key:
+            self.by_key[key] = len(self.xy)
+            self.xy.append(np.asarray(xy, dtype=float))
+        return self.by_key[key]
+
+
+def _boundary_key(domain, loop: int, seg: int, t: float):
+    n = len(domain.loops[loop])
+    if t >= 1.0:
+        seg, t = (seg + 1) % n, 0.0
+    return ("b", loop, seg, round(float(t), 12))
+
+
+def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partition:
+    """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py)."""
+    every = list(streamlines) + list(cuts)
+    lines = [np.asarray(s.points, dtype=float) for s in every]
+    ends = [(s.start, s.end) for s in every]
+    verts = _Vertices()
+    tol = 1e-9 * domain.size
+    # Split positions along each streamline: (arc-length position, vertex id).
+    splits: list[list] = [[] for _ in lines]
+    boundary_splits: dict = {li: set() for li in range(len(domain.loops))}
+    for li, loop in enumerate(domain.loops):
+        for si, curve in enumerate(loop):
+            if curve.kind != "circle":
+                boundary_splits[li].add((si, 0.0))
+    for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
+        for where, end_point, pos in ((start, pts[0], 0.0), (end, pts[-1], None)):
+            vid = _end_vertex(domain, verts, where, end_point, boundary_splits, k)
+            if vid is None:
+                continue  # a T-junction end: resolved once the other line's vertices exist
+            splits[k].append((pos if pos is not None else _length(pts), vid))
+    # T-junctions: a line ending on another splits the other there.
+    for k, (pts, (_, end)) in enumerate(zip(lines, ends)):
+        if end.kind == "streamline":
+            other = end.index
+            s = end.param * _length(lines[other])
+            vid = verts.get(("t", k), pts[-1])
+            splits[other].append((s, vid))
+            splits[k].append((_length(pts), vid))
+    # Crossings between streamlines.
+    for (i, si), (j, sj), xy in _crossings(lines, element_size, tol):
+        vid = verts.get(("x", i, round(si, 9), j, round(sj, 9)), xy)
+        splits[i].append((si, vid))
+        splits[j].append((sj, vid))
+    edges = []
+    for k, pts in enumerate(lines):
+        edges.extend(_split_line(pts, splits[k], k))
+    for li in range(len(domain.loops)):
+        edges.extend(_boundary_edges(domain, li, sorted(boundary_splits[li]), verts))
+    vertices = np.array(verts.xy)
+    blocks = _faces_to_blocks(vertices, edges, element_size)
+    return Partition(vertices=vertices, edges=edges, blocks=blocks, cuts=list(cuts))
+
+
+def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
+    if where.kind == "singularity":
+        return verts.get(("s", where.index), xy)
+    if where.kind in ("boundary", "corner"):
+        key = _boundary_key(domain, where.loop, where.segment, where.param)
+        boundary_splits[key[1]].add((key[2], key[3]))
+        return verts.get(key, domain.loops[key[1]][key[2]].point(key[3]))
+    if where.kind == "streamline":
+        return None
+    raise PartitionError(f"streamline {line_index} has an end of unknown kind {where.kind!r}")
+
+
+def _length(pts) -> float:
+    return float(np.hypot(*np.diff(pts, axis=0).T).sum())
+
+
+def _crossings(lines, h, tol):
+    """Proper crossings between different streamlines (not at shared end points)."""
+    seg_a, seg_b, owner, s0 = [], [], [], []
+    for k, pts in enumerate(lines):
+        seg_a.append(pts[:-1])
+        seg_b.append(pts[1:])
+        owner.append(np.full(len(pts) - 1, k))
+        cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+        s0.append(cum[:-1])
+    if not seg_a:
+        return []
+    a, b = np.concatenate(seg_a), np.concatenate(seg_b)
+    owner, s0 = np.concatenate(owner), np.concatenate(s0)
+    mid = 0.5 * (a + b)
+    half = 0.5 * np.hypot(*(b - a).T)
+    radius = 2 * float(half.max()) + tol
+    pairs = cKDTree(mid).query_pairs(radius, output_type="ndarray")
+    if not len(pairs):
+        return []
+    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
+    i, j = pairs[:, 0], pairs[:, 1]
+    d1, d2 = b[i] - a[i], b[j] - a[j]
+    den = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    w = a[j] - a[i]
+    ok = np.abs(den) > 1e-300
+    t = np.where(ok, (w[:, 0] * d2[:, 1] - w[:, 1] * d2[:, 0]) / np.where(ok, den, 1), -1)
+    u = np.where(ok, (w[:, 0] * d1[:, 1] - w[:, 1] * d1[:, 0]) / np.where(ok, den, 1), -1)
+    hit = ok & (t >= 0) & (t < 1) & (u >= 0) & (u < 1)
+    out = []
+    ends = {k: (lines[k][0], lines[k][-1]) for k in range(len(lines))}
+    for pi, pj, tt, uu in zip(i[hit], j[hit], t[hit], u[hit]):
+        xy = a[pi] + tt * (b[pi] - a[pi])
+        near_end = any(np.hypot(*(xy - e)) < 0.5 * h for e in ends[owner[pi]] + ends[owner[pj]])
+        if near_end:
+            continue  # lines meeting at a shared end point, not crossing
+        si = s0[pi] + tt * np.hypot(*(b[pi] - a[pi]))
+        sj = s0[pj] + uu * np.hypot(*(b[pj] - a[pj]))
+        out.append(((int(owner[pi]), float(si)), (int(owner[pj]), float(sj)), xy))
+    return out
+
+
+def _split_line(pts, splits, k):
+    """Edges of one streamline between its split positions."""
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+    splits = sorted(splits, key=lambda s: s[0])
+    edges = []
+    for (s_a, v_a), (s_b, v_b) in zip(splits[:-1], splits[1:]):
+        if v_a == v_b or s_b - s_a <= 0:
+            continue
+        inner = pts[(cum > s_a) & (cum < s_b)]
+        pa = _at(pts, cum, s_a)
+        pb = _at(pts, cum, s_b)
+        edges.append(Edge(points=np.vstack([pa, inner, pb]), a=v_a, b=v_b, streamline=k))
+    return edges
+
+
+def _at(pts, cum, s):
+    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
+    f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
+    return pts[k] + min(max(f, 0.0), 1.0) * (pts[k + 1] - pts[k])
+
+
+def _boundary_edges(domain, li, positions, verts):
+    """Edges along loop li between consecutive split positions, in the loop's direction."""
+    loop = domain.loops[li]
+    if not positions:
+        return []  # an untouched smooth loop: handled by cuts before we get here
+    edges = []
+    for k, (seg, t) in enumerate(positions):
+        nseg, nt = positions[(k + 1) % len(positions)]
+        pieces = []
+        s, tt = seg, t
+        for _ in range(len(loop) + 2):
+            if s == nseg and nt > tt:
+                pieces.append(BoundaryPiece(li, s, tt, nt))
+                break
+            pieces.append(BoundaryPiece(li, s, tt, 1.0))
+            s, tt = (s + 1) % len(loop), 0.0
+            if s == nseg and nt == 0.0:
+                break
+        pts = [loop[p.segment].point(np.linspace(p.t0, p.t1, _samples(loop[p.segment], p)))
+               for p in pieces]
+        polyline = np.vstack([pts[0]] + [q[1:] for q in pts[1:]])
+        a = verts.get(_boundary_key(domain, li, seg, t), loop[seg].point(t))
+        b = verts.get(_boundary_key(domain, li, nseg, nt), loop[nseg].point(nt))
+        edges.append(Edge(points=polyline, a=a, b=b, pieces=tuple(pieces)))
+    return edges
+
+
+def _samples(curve, piece) -> int:
+    if curve.kind == "line":
+        return 2
+    return max(3, int(math.ceil(abs(curve.sweep) * abs(piece.t1 - piece.t0) / math.radians(2)))
+               + 1)
+
+
+# ----------------------------------------------------------------------------------------
+# Faces and blocks
+
+
+def _direction(points: np.ndarray, reach: float) -> np.ndarray:
+    """Unit direction from points[0] toward the point ``reach`` along the polyline."""
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    target = _at(points, cum, min(reach, cum[-1]))
+    d = target - points[0]
+    n = np.hypot(*d)
+    if n == 0:
+        d = points[-1] - points[0]
+        n = np.hypot(*d)
+    return d / n
+
+
+def _faces_to_blocks(vertices, edges, h):
+    reach = 0.5 * h
+    half = []  # (edge id, forward)
+    out_dirs: dict = {}
+    for e, edge in enumerate(edges):
+        reach_e = min(reach, edge.length / 3)
+        for forward in (True, False):
+            pts = edge.points if forward else edge.points[::-1]
+            v = edge.a if forward else edge.b
+            d = _direction(pts, reach_e)
+            out_dirs.setdefault(v, []).append((math.atan2(d[1], d[0]), len(half)))
+            half.append((e, forward))
+    order = {}
+    for v, items in out_dirs.items():
+        items.sort()
+        for k, (_, hid) in enumerate(items):
+            order[hid] = (v, k)
+    twin = {}
+    for hid, (_, forward) in enumerate(half):
+        twin[hid] = hid + 1 if forward else hid - 1  # halves come in pairs
+
+    def head(hid):
+        e, forward = half[hid]
+        return edges[e].b if forward else edges[e].a
+
+    def next_half(hid):
+        t = twin[hid]
+        v, k = order[t]
+        items = out_dirs[v]
+        return items[(k - 1) % len(items)][1]
+
+    seen = set()
+    blocks = []
+    for start in range(len(half)):
+        if start in seen:
+            continue
+        cycle = []
+        hid = start
+        while hid not in seen:
+            seen.add(hid)
+            cycle.append(hid)
+            hid = next_half(hid)
+            if len(cycle) > len(half):
+                raise PartitionError("the arrangement of streamlines is not planar")
+        if any(edges[half[c][0]].is_boundary and not half[c][1] for c in cycle):
+            continue  # outside the domain (the outer face, or inside a hole)
+        blocks.append(_block_of(cycle, half, edges, vertices, h, head))
+    return blocks
+
+
+def _block_of(cycle, half, edges, vertices, h, head):
+    reach = 0.5 * h
+    turns = []
+    for k, hid in enumerate(cycle):
+        nxt = cycle[(k + 1) % len(cycle)]
+        e_in, f_in = half[hid]
+        e_out, f_out = half[nxt]
+        pin = edges[e_in].points if f_in else edges[e_in].points[::-1]
+        pout = edges[e_out].points if f_out else edges[e_out].points[::-1]
+        d_in = -_direction(pin[::-1], min(reach, edges[e_in].length / 3))
+        d_out = _direction(pout, min(reach, edges[e_out].length / 3))
+        turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
+        turns.append(turn)
+    turns = np.array(turns)
+    if np.any(turns < -CORNER_TURN):
+        k = int(np.argmin(turns))
+        raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
+                             f"{_fmt(vertices[head(cycle[k])])}: not a four-sided block")
+    corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
+    if len(corner_at) != 4:
+        centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
+        raise PartitionError(f"a block near {_fmt(centre)} has {len(corner_at)} corners "
+                             f"instead of 4")
+    sides = []
+    corners = []
+    for s in range(4):
+        first = (corner_at[s] + 1) % len(cycle)
+        last = corner_at[(s + 1) % 4]
+        idx = []
+        k = first
+        while True:
+            idx.append(k)
+            if k == last:
+                break
+            k = (k + 1) % len(cycle)
+        sides.append(tuple(half[cycle[i]] for i in idx))
+        corners.append(head(cycle[corner_at[s]]))
+    return Block(corners=tuple(corners), sides=tuple(sides))
+
+
+def _fmt(p) -> str:
+    return f"({p[0]:.6g}, {p[1]:.6g})"
