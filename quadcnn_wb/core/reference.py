@@ -25,7 +25,7 @@ class Reference:
     mesh: BackgroundMesh
     field: FrameField
     streamlines: tuple
-    labels: np.ndarray  # (N, 2) int8
+    labels: np.ndarray | None  # (N, 2) int8; None when not asked for
     timings: dict  # stage -> seconds
 
     def to_json(self) -> dict:
@@ -42,7 +42,7 @@ class Reference:
 
 
 def numerical_reference(domain: Domain, nodes: int = 2048,
-                        mesh: BackgroundMesh | None = None) -> Reference:
+                        mesh: BackgroundMesh | None = None, labels: bool = True) -> Reference:
     timings = {}
     clock = time.perf_counter()
     if mesh is None:
@@ -54,8 +54,11 @@ def numerical_reference(domain: Domain, nodes: int = 2048,
     clock = time.perf_counter()
     streamlines = trace_streamlines(domain, mesh, field)
     timings["tracing"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    labels = frame_labels(mesh, field.frames, streamlines)
-    timings["labels"] = time.perf_counter() - clock
+    if labels:
+        clock = time.perf_counter()
+        labels = frame_labels(mesh, field.frames, streamlines)
+        timings["labels"] = time.perf_counter() - clock
+    else:
+        labels = None
     timings["total"] = sum(timings.values())
     return Reference(domain, mesh, field, streamlines, labels, timings)

@@ -1,0 +1,47 @@
+"""Mesh quality as DESIGN.md defines it: scaled Jacobian, irregular vertices, counts."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .background import _interior_angle
+from .quadmesh import scaled_jacobians
+
+
+def boundary_quads_expected(domain, nodes, boundary) -> np.ndarray:
+    """Quads a regular boundary node has: round(interior angle / 90°), 2 on smooth stretches."""
+    expected = np.where(boundary, 2, 4)
+    tree = cKDTree(nodes)
+    tol = 1e-9 * domain.size
+    for loop in domain.loops:
+        for k, curve in enumerate(loop):
+            if curve.kind == "circle":
+                continue
+            dist, node = tree.query(curve.p0)
+            if dist <= tol:
+                angle = _interior_angle(loop[k - 1], curve)
+                expected[node] = max(1, int(round(angle / (math.pi / 2))))
+    return expected
+
+
+def irregular_vertices(quads, n_nodes: int, expected) -> np.ndarray:
+    """Nodes whose number of quads differs from what a regular vertex there would have."""
+    count = np.bincount(quads.ravel(), minlength=n_nodes)
+    used = count > 0
+    return np.nonzero(used & (count != expected))[0]
+
+
+def mesh_quality(domain, mesh) -> dict:
+    sj = scaled_jacobians(mesh.nodes, mesh.quads)
+    expected = boundary_quads_expected(domain, mesh.nodes, mesh.boundary)
+    irregular = irregular_vertices(mesh.quads, len(mesh.nodes), expected)
+    return {
+        "min_scaled_jacobian": float(sj.min()) if len(sj) else 0.0,
+        "mean_scaled_jacobian": float(sj.mean()) if len(sj) else 0.0,
+        "irregular_vertices": int(len(irregular)),
+        "blocks": int(len(np.unique(mesh.block_of_quad))),
+        "quads": int(len(mesh.quads)),
+    }
