@@ -51,7 +51,11 @@ demo: setup
 	    -o $(OUT)/four_hole_background.json --png $(OUT)/four_hole_background.png
 	$(PY) -m quadcnn_wb field resources/examples/four_hole.json \
 	    -o $(OUT)/four_hole_field.json --png $(OUT)/four_hole_field.png
-	@echo "wrote $(OUT)/four_hole_background.png and $(OUT)/four_hole_field.png (+ .json)"
+	$(PY) -m quadcnn_wb mesh resources/examples/four_hole.json --method numerical \
+	    -o $(OUT)/four_hole_mesh.json --png $(OUT)/four_hole_mesh.png
+	$(PY) -m quadcnn_wb mesh resources/examples/four_hole.json --method numerical \
+	    -o $(OUT)/four_hole_mesh.inp
+	@echo "wrote $(OUT)/four_hole_{background,field,mesh}.png, their .json and four_hole_mesh.inp"
 
 lint: setup
 	$(VENV)/bin/ruff check .

@@ -14,6 +14,7 @@ from .core.atomic import write_json_atomic
 from .core.background import BackgroundMeshError, background_mesh
 from .core.domain import DomainError, load_domain
 from .core.framefield import FieldError
+from .core.partition import PartitionError
 
 
 class UsageError(Exception):
@@ -56,7 +57,33 @@ def build_parser() -> argparse.ArgumentParser:
     fd.add_argument("--png", help="write a picture: crosses, singular points, streamlines, "
                     "label-1 vectors")
     fd.set_defaults(run=_run_field)
+
+    ms = commands.add_parser("mesh", help="block-structured quad mesh")
+    ms.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
+    ms.add_argument("--method", choices=["auto", "cnn", "numerical"], default="auto",
+                    help="how streamlines are found (default auto: a matching model if one "
+                    "is installed, else numerical tracing)")
+    ms.add_argument("--model", help="ONNX model for the cnn method")
+    ms.add_argument("--size", type=_positive_float, help="target element size (default: the "
+                    "domain diagonal / 40)")
+    ms.add_argument("--nodes", type=_positive_int, default=2048,
+                    help="background mesh node count (default 2048)")
+    ms.add_argument("-o", "--output", help="mesh file: .json (DESIGN.md 'mesh'), .msh, .vtk "
+                    "or .inp (CalculiX/Abaqus, CPS4)")
+    ms.add_argument("--png", help="write a picture: blocks coloured, streamlines, singular "
+                    "points")
+    ms.set_defaults(run=_run_mesh)
     return parser
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive size, got {text!r}")
+    return value
 
 
 def _check_output(path, suffixes) -> Path | None:
@@ -104,11 +131,36 @@ def _run_field(args) -> None:
           f"streamlines ({capped} capped), {int(ref.labels.sum())} label-1 vectors")
 
 
+def _run_mesh(args) -> None:
+    from .core.export import FORMATS, export
+    from .core.pipeline import mesh_domain
+
+    out = _check_output(args.output, FORMATS)
+    png = _check_output(args.png, {".png"})
+    if args.method == "cnn" or args.model:
+        raise UsageError("the cnn method needs trained models, which this version does not "
+                         "ship yet; use --method numerical (or auto)")
+    result = mesh_domain(load_domain(args.input), size=args.size, nodes=args.nodes)
+    if out:
+        export(result, out)
+    if png:
+        from .viz.mesh_plot import plot_mesh
+
+        plot_mesh(result, png)
+    q = result.quality
+    print(f"{q['quads']} quads in {q['blocks']} blocks, min scaled Jacobian "
+          f"{q['min_scaled_jacobian']:.3f} (mean {q['mean_scaled_jacobian']:.3f}), "
+          f"{q['irregular_vertices']} irregular vertices, "
+          f"{len(result.reference.field.singularities)} singular points, "
+          f"{result.timings['total']:.3f} s ({result.method})")
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         args.run(args)
-    except (DomainError, BackgroundMeshError, FieldError, UsageError, OSError) as exc:
+    except (DomainError, BackgroundMeshError, FieldError, PartitionError, UsageError,
+            OSError) as exc:
         message = " ".join(str(exc).split())
         print(f"error: {message}", file=sys.stderr)
         return 2
