@@ -67,6 +67,7 @@ test: setup lint
 bench: setup
 	$(PY) -m quadcnn_wb.bench.background_speed
 	$(PY) -m quadcnn_wb.bench.field_speed
+	$(PY) -m quadcnn_wb.bench.mesh_vs_gmsh
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache
