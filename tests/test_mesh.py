@@ -1,0 +1,130 @@
+"""The numerical path end to end: valid conforming meshes, regular but for the singular
+points, quantization equalities, exports that read back."""
+
+from __future__ import annotations
+
+import functools
+import json
+
+import meshio
+import numpy as np
+import pytest
+from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
+from meshcheck import check_quad_mesh
+from shapes import OWN_SHAPES
+
+from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.pipeline import mesh_domain
+from quadcnn_wb.core.quantize import side_counts
+
+MESHABLE_OWN = [name for name in OWN_SHAPES if name != "hexagon"]
+
+
+@functools.cache
+def meshed(name):
+    if name in EXAMPLE_NAMES:
+        domain = load_domain(SHARED_EXAMPLES / f"{name}.json")
+    else:
+        domain = domain_from_json({"loops": OWN_SHAPES[name][0]})
+    return mesh_domain(domain)
+
+
+def on_boundary_of(domain):
+    tol = 1e-9 * domain.size
+
+    def test(p):
+        return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol
+                   for loop in domain.loops for c in loop)
+    return test
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES + MESHABLE_OWN)
+def test_mesh_is_valid_and_conforming(name):
+    result = meshed(name)
+    mesh, domain = result.mesh, result.domain
+    boundary_edges = check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary_of(domain))
+    on_curve = on_boundary_of(domain)
+    assert all(on_curve(mesh.nodes[i]) for i in np.nonzero(mesh.boundary)[0])
+    assert {n for e in boundary_edges for n in e} == set(np.nonzero(mesh.boundary)[0])
+    assert len(mesh.block_of_quad) == len(mesh.quads)
+    assert result.quality["min_scaled_jacobian"] > 0.5
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES + MESHABLE_OWN)
+def test_only_the_singular_points_are_irregular(name):
+    result = meshed(name)
+    assert result.quality["irregular_vertices"] == len(result.reference.field.singularities)
+    mesh = result.mesh
+    count = np.bincount(mesh.quads.ravel(), minlength=len(mesh.nodes))
+    for s in result.reference.field.singularities:
+        # Partition vertices are the mesh's first nodes; smoothing may have moved them.
+        node = int(np.argmin(np.hypot(*(result.partition.vertices - s.xy).T)))
+        assert count[node] == s.valence
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_opposite_block_sides_have_equal_segment_counts(name):
+    result = meshed(name)
+    assert (result.counts >= 1).all()
+    for sides in side_counts(result.partition, result.counts):
+        assert sides[0] == sides[2] and sides[1] == sides[3]
+    assert len(result.partition.blocks) == result.quality["blocks"]
+
+
+def test_element_size_follows_the_request():
+    domain = load_domain(SHARED_EXAMPLES / "l_shape.json")
+    coarse, fine = mesh_domain(domain, size=0.2), mesh_domain(domain, size=0.05)
+    assert coarse.quality["quads"] == 75  # 3 unit squares at 5x5 each
+    assert fine.quality["quads"] == 1200
+
+
+def test_annulus_gets_a_cut_and_meshes():
+    result = meshed("annulus")
+    assert len(result.cuts) == 1 and result.quality["blocks"] == 1
+    assert result.quality["irregular_vertices"] == 0
+
+
+def test_mesh_exports_read_back(tmp_path):
+    result = meshed("plate_hole")
+    from quadcnn_wb.core.export import export
+
+    for suffix in (".msh", ".vtk"):
+        export(result, tmp_path / f"m{suffix}")
+        back = meshio.read(tmp_path / f"m{suffix}")
+        assert back.cells[0].type == "quad"
+        assert np.array_equal(back.cells[0].data, result.mesh.quads)
+        assert np.allclose(back.points[:, :2], result.mesh.nodes)
+    export(result, tmp_path / "m.inp")
+    text = (tmp_path / "m.inp").read_text()
+    assert "*ELEMENT, TYPE=CPS4, ELSET=EALL" in text
+    for name in ("LOOP0", "LOOP1", "LOOP0_SEG2", "BLOCK0"):
+        assert f"={name}\n" in text
+    back = meshio.read(tmp_path / "m.inp", file_format="abaqus")
+    assert len(back.points) == len(result.mesh.nodes)
+    assert sum(len(c.data) for c in back.cells) == len(result.mesh.quads)
+
+
+def test_mesh_command_json_contract(tmp_path):
+    out, png = tmp_path / "mesh.json", tmp_path / "mesh.png"
+    result = run_cli("mesh", SHARED_EXAMPLES / "plate_hole.json", "--method", "numerical",
+                     "--size", "0.08", "-o", out, "--png", png)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(out.read_text())
+    assert set(data) >= {"nodes", "quads", "block_of_quad", "singularities", "streamlines",
+                         "method", "fallback", "quality", "timings"}
+    assert data["method"] == "numerical" and data["fallback"] == []
+    assert set(data["quality"]) == {"min_scaled_jacobian", "mean_scaled_jacobian",
+                                    "irregular_vertices", "blocks", "quads"}
+    assert data["quality"]["irregular_vertices"] == 4
+    assert "total" in data["timings"]
+    assert len(data["block_of_quad"]) == len(data["quads"]) == data["quality"]["quads"]
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
+    for args, message in ((["--method", "cnn"], "cnn method needs trained models"),
+                          (["--size", "-1"], "expected a positive size"),
+                          (["-o", str(tmp_path / "m.stl")], "output must end in")):
+        result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", *args)
+        assert result.returncode == 2, result.stderr
+        assert result.stderr.startswith("error:") and message in result.stderr
