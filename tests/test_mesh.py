@@ -128,3 +128,13 @@ def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
         result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", *args)
         assert result.returncode == 2, result.stderr
         assert result.stderr.startswith("error:") and message in result.stderr
+
+
+def test_a_partition_that_is_not_four_sided_is_refused():
+    from quadcnn_wb.core.partition import PartitionError, build_partition
+
+    result = meshed("plate_hole")
+    lines = list(result.reference.streamlines)
+    incomplete = [line for line in lines if line.end.kind != "singularity"][1:]
+    with pytest.raises(PartitionError, match="corners instead of 4|turns back"):
+        build_partition(result.domain, incomplete, result.reference.mesh.element_size)
