@@ -40,40 +40,43 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="quadcnn", description="Block-structured quad meshing guided by "
                      "frame fields and a CNN (see README.md).")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    bg = commands.add_parser("background", help="triangular background mesh of a domain")
-    bg.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
-    bg.add_argument("--nodes", type=_positive_int, default=2048,
-                    help="target node count (default 2048, held within 5%%)")
-    bg.add_argument("-o", "--output", help="write the mesh as JSON (DESIGN.md 'background')")
-    bg.add_argument("--png", help="write a picture of the mesh, boundary and corners")
+    bg = _stage_parser(commands, "background", "triangular background mesh of a domain",
+                       "target node count (default 2048, held within 5%%)",
+                       "write the mesh as JSON (DESIGN.md 'background')",
+                       "write a picture of the mesh, boundary and corners")
     bg.set_defaults(run=_run_background)
 
-    fd = commands.add_parser("field", help="cross field, singular points, streamlines, labels")
-    fd.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
-    fd.add_argument("--nodes", type=_positive_int, default=2048,
-                    help="background mesh node count (default 2048)")
-    fd.add_argument("-o", "--output", help="write frames, singularities, streamlines and "
-                    "labels as JSON (DESIGN.md 'field')")
-    fd.add_argument("--png", help="write a picture: crosses, singular points, streamlines, "
-                    "label-1 vectors")
+    fd = _stage_parser(commands, "field", "cross field, singular points, streamlines, labels",
+                       "background mesh node count (default 2048)",
+                       "write frames, singularities, streamlines and labels as JSON "
+                       "(DESIGN.md 'field')",
+                       "write a picture: crosses, singular points, streamlines, label-1 "
+                       "vectors")
     fd.set_defaults(run=_run_field)
 
-    ms = commands.add_parser("mesh", help="block-structured quad mesh")
-    ms.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
+    ms = _stage_parser(commands, "mesh", "block-structured quad mesh",
+                       "background mesh node count (default 2048)",
+                       "mesh file: .json (DESIGN.md 'mesh'), .msh, .vtk or .inp "
+                       "(CalculiX/Abaqus, CPS4)",
+                       "write a picture: blocks coloured, streamlines, singular points")
     ms.add_argument("--method", choices=["auto", "cnn", "numerical"], default="auto",
                     help="how streamlines are found (default auto: a matching model if one "
                     "is installed, else numerical tracing)")
     ms.add_argument("--model", help="ONNX model for the cnn method")
     ms.add_argument("--size", type=_positive_float, help="target element size (default: the "
                     "domain diagonal / 40)")
-    ms.add_argument("--nodes", type=_positive_int, default=2048,
-                    help="background mesh node count (default 2048)")
-    ms.add_argument("-o", "--output", help="mesh file: .json (DESIGN.md 'mesh'), .msh, .vtk "
-                    "or .inp (CalculiX/Abaqus, CPS4)")
-    ms.add_argument("--png", help="write a picture: blocks coloured, streamlines, singular "
-                    "points")
     ms.set_defaults(run=_run_mesh)
     return parser
+
+
+def _stage_parser(commands, name, summary, nodes_help, output_help, png_help):
+    """A sub-command that reads a domain and writes a file and a picture of one stage."""
+    sub = commands.add_parser(name, help=summary)
+    sub.add_argument("input", help="Domain JSON v1, STEP, BREP or IGES file")
+    sub.add_argument("--nodes", type=_positive_int, default=2048, help=nodes_help)
+    sub.add_argument("-o", "--output", help=output_help)
+    sub.add_argument("--png", help=png_help)
+    return sub
 
 
 def _positive_float(text: str) -> float:

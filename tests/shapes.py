@@ -75,3 +75,14 @@ OWN_SHAPES = {
     "T shape": ([polygon([[0, 0], [1, 0], [1, 2], [2, 2], [2, 3], [-1, 3], [-1, 2],
                           [0, 2]])], 0, 0),
 }
+
+
+def named_domain(name):
+    """A shared example (by file stem) or one of OWN_SHAPES, as a Domain."""
+    from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
+
+    from quadcnn_wb.core.domain import domain_from_json, load_domain
+
+    if name in EXAMPLE_NAMES:
+        return load_domain(SHARED_EXAMPLES / f"{name}.json")
+    return domain_from_json({"loops": OWN_SHAPES[name][0]})

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
 from meshcheck import check_quad_mesh
-from shapes import OWN_SHAPES
+from shapes import OWN_SHAPES, named_domain
 
-from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.domain import load_domain
 from quadcnn_wb.core.pipeline import mesh_domain
 from quadcnn_wb.core.quantize import side_counts
 
@@ -22,11 +22,7 @@ MESHABLE_OWN = [name for name in OWN_SHAPES if name != "hexagon"]
 
 @functools.cache
 def meshed(name):
-    if name in EXAMPLE_NAMES:
-        domain = load_domain(SHARED_EXAMPLES / f"{name}.json")
-    else:
-        domain = domain_from_json({"loops": OWN_SHAPES[name][0]})
-    return mesh_domain(domain)
+    return mesh_domain(named_domain(name))
 
 
 def on_boundary_of(domain):

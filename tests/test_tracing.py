@@ -8,9 +8,9 @@ from collections import Counter
 import numpy as np
 import pytest
 from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
-from shapes import OWN_SHAPES
+from shapes import OWN_SHAPES, named_domain
 
-from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.domain import load_domain
 from quadcnn_wb.core.labels import resample
 from quadcnn_wb.core.reference import numerical_reference
 
@@ -19,11 +19,7 @@ CASES = EXAMPLE_NAMES + list(OWN_SHAPES)
 
 @functools.cache
 def reference(name):
-    if name in EXAMPLE_NAMES:
-        domain = load_domain(SHARED_EXAMPLES / f"{name}.json")
-    else:
-        domain = domain_from_json({"loops": OWN_SHAPES[name][0]})
-    return numerical_reference(domain)
+    return numerical_reference(named_domain(name))
 
 
 @pytest.mark.parametrize("name", CASES)
