@@ -31,33 +31,8 @@ def stadium():
             {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]
 
 
-def transform_domain(data, matrix, shift=(0.0, 0.0)):
-    """Apply p -> matrix @ p + shift to every point and radius of a Domain JSON dict."""
-    m = np.asarray(matrix, dtype=float)
-    scale = math.sqrt(abs(np.linalg.det(m)))
-
-    def tp(p):
-        return (m @ np.asarray(p, dtype=float) + shift).tolist()
-
-    loops = []
-    for loop in data["loops"]:
-        out = []
-        for seg in loop:
-            (kind, value), = seg.items()
-            if kind == "circle":
-                out.append({"circle": {"center": tp(value["center"]),
-                                       "radius": value["radius"] * scale}})
-            else:
-                out.append({kind: [tp(p) for p in value]})
-        loops.append(out)
-    return {"loops": loops}
-
-
-def rotation(degrees, scale=1.0, mirror=False):
-    a = math.radians(degrees)
-    m = scale * np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
-    return m @ np.diag([-1.0, 1.0]) if mirror else m
-
+from quadcnn_wb.core.transform import similarity as rotation  # noqa: E402,F401
+from quadcnn_wb.core.transform import transform_domain_json as transform_domain  # noqa: E402,F401
 
 # name -> (loops, expected valence-3 count, expected valence-5 count)
 OWN_SHAPES = {

@@ -1,0 +1,1 @@
+"""Running trained models with onnxruntime (no torch needed)."""
