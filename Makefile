@@ -35,7 +35,7 @@ $(PY):
 	/usr/bin/python3 -m venv --system-site-packages $(VENV)
 
 $(STAMP): pyproject.toml | $(PY)
-	$(PY) -m pip install -q --disable-pip-version-check -e ".[dev]"
+	$(PY) -m pip install -q --disable-pip-version-check -e ".[dev,train]"
 	touch $(STAMP)
 
 # Plain `freecadcmd` finds the workbench (and, through Init.py, the venv's packages).

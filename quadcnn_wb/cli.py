@@ -66,6 +66,36 @@ def build_parser() -> argparse.ArgumentParser:
     ms.add_argument("--size", type=_positive_float, help="target element size (default: the "
                     "domain diagonal / 40)")
     ms.set_defaults(run=_run_mesh)
+
+    fam = commands.add_parser("families", help="list the shape families and their parameters")
+    fam.set_defaults(run=_run_families)
+
+    ds = commands.add_parser("dataset", help="generate training data for one shape family")
+    ds.add_argument("family")
+    ds.add_argument("-n", type=_positive_count, default=2000, help="samples (default 2000)")
+    ds.add_argument("--seed", type=int, default=0)
+    ds.add_argument("--nodes", type=_positive_int, default=2048)
+    ds.add_argument("--workers", type=_positive_count, help="processes (default: all cores)")
+    ds.add_argument("-o", "--output", required=True, help="data set file (.npz)")
+    ds.set_defaults(run=_run_dataset)
+
+    tr = commands.add_parser("train", help="train a network on a data set, export ONNX")
+    tr.add_argument("data", help="data set from 'quadcnn dataset'")
+    tr.add_argument("-o", "--output", required=True, help="model file (.onnx); metadata "
+                    "goes beside it (.json)")
+    tr.add_argument("--epochs", type=_positive_count, default=30)
+    tr.add_argument("--seed", type=int, default=0)
+    tr.add_argument("--recipe", choices=["paper", "fast"], default="paper")
+    tr.add_argument("--threads", type=_positive_count, default=2)
+    tr.add_argument("--patience", type=_positive_count, default=6)
+    tr.set_defaults(run=_run_train)
+
+    ev = commands.add_parser("evaluate", help="label metrics of a model on a data set")
+    ev.add_argument("model", help="model file (.onnx)")
+    ev.add_argument("data", help="data set from 'quadcnn dataset'")
+    ev.add_argument("-o", "--output", help="write the metrics as JSON")
+    ev.add_argument("--threads", type=_positive_count, default=2)
+    ev.set_defaults(run=_run_evaluate)
     return parser
 
 
@@ -77,6 +107,16 @@ def _stage_parser(commands, name, summary, nodes_help, output_help, png_help):
     sub.add_argument("-o", "--output", help=output_help)
     sub.add_argument("--png", help=png_help)
     return sub
+
+
+def _positive_count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1, got {value}")
+    return value
 
 
 def _positive_float(text: str) -> float:
@@ -156,6 +196,72 @@ def _run_mesh(args) -> None:
           f"{q['irregular_vertices']} irregular vertices, "
           f"{len(result.reference.field.singularities)} singular points, "
           f"{result.timings['total']:.3f} s ({result.method})")
+
+
+def _run_families(args) -> None:
+    from .learn.families import FAMILIES
+
+    for fam in FAMILIES.values():
+        print(f"{fam.name}: {fam.description}; singular points: {fam.singularities[0]} "
+              f"valence-3, {fam.singularities[1]} valence-5")
+        for name, (lo, hi) in fam.ranges.items():
+            print(f"    {name}: {lo:g} .. {hi:g}")
+
+
+def _run_dataset(args) -> None:
+    from .learn.dataset import generate, save_dataset
+    from .learn.families import family
+
+    try:
+        family(args.family)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    out = _check_output(args.output, {".npz"})
+    samples, dropped = generate(args.family, args.n, args.seed, nodes=args.nodes,
+                                workers=args.workers)
+    save_dataset(out, samples, {"family": args.family, "seed": args.seed, "requested": args.n,
+                                "nodes": args.nodes, "dropped": dict(dropped)})
+    reasons = ", ".join(f"{k}: {v}" for k, v in sorted(dropped.items())) or "none"
+    print(f"{len(samples)} samples written to {out}; dropped {sum(dropped.values())} "
+          f"({reasons})")
+
+
+def _run_train(args) -> None:
+    try:
+        from .learn.train import train
+    except ImportError:
+        raise UsageError("training needs PyTorch: .venv/bin/pip install -e '.[train]'") from None
+    out = _check_output(args.output, {".onnx"})
+    try:
+        meta = train(args.data, out, epochs=args.epochs, seed=args.seed, recipe=args.recipe,
+                     threads=args.threads, patience=args.patience)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    m = meta["metrics_test_split"]
+    print(f"{out}: test split IoU {m['iou']:.3f}, accuracy {m['accuracy']:.4f} "
+          f"(all-zeros {m['zero_baseline_accuracy']:.4f}), best epoch "
+          f"{meta['recipe']['best_epoch']}")
+
+
+def _run_evaluate(args) -> None:
+    from .infer.metrics import Confusion
+    from .infer.predictor import ModelError, Predictor
+    from .learn.dataset import load_dataset
+
+    out = _check_output(args.output, {".json"})
+    try:
+        predictor = Predictor(args.model, threads=args.threads)
+        samples, _ = load_dataset(args.data)
+    except (ModelError, ValueError) as exc:
+        raise UsageError(str(exc)) from None
+    confusion = Confusion()
+    for sample in samples:
+        confusion.add(predictor.labels(sample.x), sample.y)
+    metrics = confusion.metrics(len(samples))
+    if out:
+        write_json_atomic(out, metrics)
+    print(" ".join(f"{k}={v:.4f}" if isinstance(v, float) else f"{k}={v}"
+                   for k, v in metrics.items()))
 
 
 def main(argv=None) -> int:

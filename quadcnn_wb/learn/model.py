@@ -1,0 +1,110 @@
+"""The network of the paper's §3.1 and Table 1, in PyTorch.
+
+How the inconsistencies of Table 1 are resolved here:
+- Input: one point per background node, (x, y, v1x, v1y) (see infer.encoding); Table 1's
+  [B, 2048, 4] read literally.  Output: two logits per point, the labels of v1 and v2
+  (Table 1's [B, 2048, 2]); a sigmoid makes them probabilities (in the loss, and in the
+  exported ONNX graph).
+- EdgeConv (Wang et al., DGCNN): edge features [x_j - x_i, x_i] over the k = 10 nearest
+  neighbours (the point itself included), a shared 1x1 convolution, max over neighbours.
+  Table 1 lists the edge-feature width as the stage's input width; with [x_j - x_i, x_i]
+  it is twice that, which is what this code uses.  The neighbours are found once, on the
+  positions (a static graph): the frame field varies smoothly, so neighbourhoods in space
+  are the meaningful ones, and kNN is the costly part.
+- Each stage concatenates its EdgeConv and its plain 1x1 convolution (16, 32, 64 channels
+  each), so a stage outputs 32, 64, 128 channels and the three together 224 (Table 1's
+  "Concat4" 112 counts one branch per stage).
+- Table 1's max pool goes from 112 (here 224) to 512 channels, which a pool cannot do: a
+  1x1 convolution to 512 precedes the global max pool.  The 512-wide global feature is
+  expanded to every point and joined with the 224 per-point features (736 channels).
+- Head: 1x1 convolutions 256, 256 (dropout 0.5 after each), 128, 2, with batch norm and
+  ReLU between them.  About 420k parameters.
+kNN uses topk on minus the squared distance from batched matrix products (no cdist, no
+Python loop over points), so any number of points N works, in training and in ONNX.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+K_NEIGHBOURS = 10
+STAGE_WIDTHS = (16, 32, 64)
+GLOBAL_WIDTH = 512
+
+
+def knn(pos: torch.Tensor, k: int) -> torch.Tensor:
+    """(B, N, k) indices of the k nearest points (self included) of each point."""
+    square = (pos * pos).sum(dim=-1)
+    dist = square.unsqueeze(2) - 2.0 * pos @ pos.transpose(1, 2) + square.unsqueeze(1)
+    return torch.topk(-dist, k, dim=-1).indices
+
+
+class EdgeConv(nn.Module):
+    def __init__(self, cin: int, cout: int):
+        super().__init__()
+        self.mlp = nn.Sequential(nn.Conv2d(2 * cin, cout, 1, bias=False),
+                                 nn.BatchNorm2d(cout), nn.LeakyReLU(0.2))
+
+    def forward(self, x: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
+        b, c, n = x.shape
+        k = idx.shape[-1]
+        points = x.transpose(1, 2)  # (B, N, C)
+        gathered = torch.gather(points, 1, idx.reshape(b, n * k, 1).expand(b, n * k, c))
+        neighbours = gathered.reshape(b, n, k, c)
+        centre = points.unsqueeze(2).expand(b, n, k, c)
+        edges = torch.cat([neighbours - centre, centre], dim=-1).permute(0, 3, 1, 2)
+        return self.mlp(edges).max(dim=-1).values  # (B, cout, N)
+
+
+def _pointwise(cin: int, cout: int) -> nn.Sequential:
+    return nn.Sequential(nn.Conv1d(cin, cout, 1, bias=False), nn.BatchNorm1d(cout),
+                         nn.LeakyReLU(0.2))
+
+
+class QuadCNN(nn.Module):
+    def __init__(self, k: int = K_NEIGHBOURS, widths=STAGE_WIDTHS, dropout: float = 0.5):
+        super().__init__()
+        self.k = k
+        self.edge = nn.ModuleList()
+        self.point = nn.ModuleList()
+        cin = 4
+        for w in widths:
+            self.edge.append(EdgeConv(cin, w))
+            self.point.append(_pointwise(cin, w))
+            cin = 2 * w
+        local = 2 * sum(widths)
+        self.to_global = _pointwise(local, GLOBAL_WIDTH)
+        self.head = nn.Sequential(
+            nn.Conv1d(local + GLOBAL_WIDTH, 256, 1, bias=False), nn.BatchNorm1d(256), nn.ReLU(),
+            nn.Dropout(dropout),
+            nn.Conv1d(256, 256, 1, bias=False), nn.BatchNorm1d(256), nn.ReLU(),
+            nn.Dropout(dropout),
+            nn.Conv1d(256, 128, 1, bias=False), nn.BatchNorm1d(128), nn.ReLU(),
+            nn.Conv1d(128, 2, 1))
+
+    def forward(self, x: torch.Tensor, idx: torch.Tensor | None = None) -> torch.Tensor:
+        """(B, N, 4) points -> (B, N, 2) logits."""
+        if idx is None:
+            with torch.no_grad():
+                idx = knn(x[..., :2], self.k)
+        h = x.transpose(1, 2)
+        stages = []
+        for edge, point in zip(self.edge, self.point):
+            h = torch.cat([edge(h, idx), point(h)], dim=1)
+            stages.append(h)
+        local = torch.cat(stages, dim=1)
+        pooled = self.to_global(local).max(dim=-1, keepdim=True).values
+        joined = torch.cat([local, pooled.expand(-1, -1, local.shape[-1])], dim=1)
+        return self.head(joined).transpose(1, 2)
+
+
+class Probabilities(nn.Module):
+    """What is exported to ONNX: the network with its sigmoid."""
+
+    def __init__(self, net: QuadCNN):
+        super().__init__()
+        self.net = net
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return torch.sigmoid(self.net(x))
