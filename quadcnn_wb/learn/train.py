@@ -153,7 +153,7 @@ def export_onnx(net: QuadCNN, path) -> None:
     from .model import Probabilities
 
     net.eval()
-    wrapped = Probabilities(net)
+    wrapped = Probabilities(net).eval()  # export restores this mode afterwards
     example = torch.zeros(1, 64, 4)
     example[..., :2] = torch.rand(1, 64, 2)
 

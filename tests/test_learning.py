@@ -1,0 +1,161 @@
+"""Families, augmentation, data sets, the network, training, ONNX parity and evaluation:
+a tiny end-to-end run (a few samples, one epoch) — CI never trains a full model."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+from conftest import run_cli
+
+from quadcnn_wb.core.partition import build_partition
+from quadcnn_wb.core.reference import numerical_reference
+from quadcnn_wb.infer.encoding import canonical_angle, encode
+from quadcnn_wb.infer.predictor import ModelError, Predictor
+from quadcnn_wb.learn.dataset import generate, load_dataset, make_sample, save_dataset
+from quadcnn_wb.learn.families import FAMILIES
+from quadcnn_wb.learn.model import QuadCNN, knn
+from quadcnn_wb.learn.train import export_onnx, train
+
+
+@pytest.mark.parametrize("name", sorted(FAMILIES))
+def test_family_members_keep_the_topology_and_singular_points(name):
+    fam = FAMILIES[name]
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        params, domain = fam.sample(rng)
+        assert set(params) == set(fam.ranges)
+        ref = numerical_reference(domain, nodes=1200, labels=False)
+        counts = ref.field.valences()
+        assert (counts[3], counts[5]) == fam.singularities
+        if name not in ("four_hole", "plate_hole"):  # the data set drops the few that fail
+            build_partition(domain, ref.streamlines, ref.mesh.element_size)
+
+
+def test_samples_are_deterministic_and_normalised():
+    a, reason = make_sample("l_shape", seed=5, index=3, nodes=800)
+    b, _ = make_sample("l_shape", seed=5, index=3, nodes=800)
+    assert reason is None
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+    other, _ = make_sample("l_shape", seed=5, index=4, nodes=800)
+    assert not np.array_equal(a.x[:50], other.x[:50])
+    lo, hi = a.x[:, :2].min(axis=0), a.x[:, :2].max(axis=0)
+    assert np.isclose(np.hypot(*(hi - lo)), 1.0, atol=0.02)  # unit diagonal (after bending)
+    assert np.allclose(np.hypot(a.x[:, 2], a.x[:, 3]), 1.0, atol=1e-6)
+    angle = np.arctan2(a.x[:, 3], a.x[:, 2])
+    assert np.all(angle > -np.pi / 4 - 1e-6) and np.all(angle <= np.pi / 4 + 1e-6)
+    assert 0 < a.y.mean() < 0.2 and set(np.unique(a.y)) == {0, 1}
+
+
+def test_encoding_ignores_placement_and_scale():
+    nodes = np.random.default_rng(0).uniform(size=(50, 2))
+    theta = np.random.default_rng(1).uniform(-3, 3, size=50)
+    assert np.allclose(encode(nodes, theta), encode(nodes * 1e4 + 7, theta), atol=1e-6)
+    assert np.allclose(canonical_angle(theta + np.pi / 2), canonical_angle(theta), atol=1e-9)
+
+
+def test_network_shapes_and_parameter_count():
+    net = QuadCNN().eval()
+    assert 380_000 < sum(p.numel() for p in net.parameters()) < 460_000
+    for n in (37, 500):
+        out = net(torch.rand(2, n, 4))
+        assert out.shape == (2, n, 2)
+    pos = torch.rand(1, 30, 2)
+    idx = knn(pos, 10)
+    brute = torch.argsort(((pos[0, :, None] - pos[0, None]) ** 2).sum(-1), dim=1)[:, :10]
+    assert torch.equal(torch.sort(idx[0], dim=1).values, torch.sort(brute, dim=1).values)
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """A 6-sample data set, a one-epoch model and its ONNX export."""
+    folder = tmp_path_factory.mktemp("tiny")
+    samples, dropped = generate("concave", 6, seed=3, nodes=600, workers=2, progress=False)
+    assert len(samples) + sum(dropped.values()) == 6 and len(samples) >= 4
+    data = folder / "data.npz"
+    save_dataset(data, samples, {"family": "concave", "seed": 3})
+    model = folder / "model.onnx"
+    meta = train(data, model, epochs=1, seed=0, recipe="fast", threads=2, progress=False)
+    return data, model, meta, samples
+
+
+def test_data_set_round_trip(tiny):
+    data, _, _, samples = tiny
+    back, meta = load_dataset(data)
+    assert meta["family"] == "concave" and meta["samples"] == len(samples)
+    for a, b in zip(samples, back):
+        assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+
+
+def test_training_writes_model_and_metadata(tiny):
+    _, model, meta, _ = tiny
+    disk = json.loads(model.with_suffix(".json").read_text())
+    assert disk["sha256"] == meta["sha256"]
+    import hashlib
+
+    assert hashlib.sha256(model.read_bytes()).hexdigest() == meta["sha256"]
+    for key in ("family", "input", "threshold", "recipe", "data", "metrics_test_split",
+                "versions"):
+        assert key in disk
+    assert set(disk["metrics_test_split"]) == {"accuracy", "iou", "miou", "precision",
+                                                "recall", "zero_baseline_accuracy", "samples"}
+
+
+def test_onnx_matches_torch(tiny, tmp_path):
+    _, _, _, samples = tiny
+    torch.manual_seed(1)
+    net = QuadCNN().eval()
+    path = tmp_path / "parity.onnx"
+    export_onnx(net, path)
+    predictor = Predictor(path, threads=1)
+    agree = total = 0
+    for sample in samples:
+        with torch.no_grad():
+            ref = torch.sigmoid(net(torch.from_numpy(sample.x[None])))[0].numpy()
+        got = predictor.probabilities(sample.x)
+        assert np.allclose(got, ref, atol=1e-4)
+        agree += int(np.sum((got >= 0.5) == (ref >= 0.5)))
+        total += ref.size
+    assert agree / total >= 0.999
+
+
+def test_evaluate_command(tiny, tmp_path):
+    data, model, _, _ = tiny
+    out = tmp_path / "metrics.json"
+    result = run_cli("evaluate", model, data, "-o", out)
+    assert result.returncode == 0, result.stderr
+    metrics = json.loads(out.read_text())
+    assert metrics["samples"] >= 4
+    assert 0.0 <= metrics["iou"] <= 1.0 and metrics["zero_baseline_accuracy"] > 0.8
+
+
+def test_bad_models_and_data_are_refused(tmp_path):
+    corrupt = tmp_path / "corrupt.onnx"
+    corrupt.write_bytes(b"not a model")
+    with pytest.raises(ModelError, match="not a readable ONNX model"):
+        Predictor(corrupt)
+    with pytest.raises(ModelError, match="no such model file"):
+        Predictor(tmp_path / "missing.onnx")
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"zzz")
+    result = run_cli("evaluate", corrupt, bad)
+    assert result.returncode == 2 and result.stderr.startswith("error:")
+    with pytest.raises(ValueError, match="not a QuadCNN data set"):
+        load_dataset(bad)
+
+
+def test_families_and_dataset_commands(tmp_path):
+    listing = run_cli("families")
+    assert listing.returncode == 0
+    for name in FAMILIES:
+        assert listing.stdout.count(f"{name}:") == 1
+    out = tmp_path / "d.npz"
+    result = run_cli("dataset", "semicircle", "-n", "3", "--seed", "2", "--nodes", "500",
+                     "--workers", "1", "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert "samples written" in result.stdout
+    assert load_dataset(out)[1]["samples"] >= 2
+    bad = run_cli("dataset", "hexagonal", "-o", out)
+    assert bad.returncode == 2 and "unknown family" in bad.stderr
