@@ -203,7 +203,7 @@ def _run_families(args) -> None:
 
     for fam in FAMILIES.values():
         print(f"{fam.name}: {fam.description}; singular points: {fam.singularities[0]} "
-              f"valence-3, {fam.singularities[1]} valence-5")
+              f"valence-3, {fam.singularities[1]} valence-5; topology {fam.topology}")
         for name, (lo, hi) in fam.ranges.items():
             print(f"    {name}: {lo:g} .. {hi:g}")
 
@@ -213,14 +213,15 @@ def _run_dataset(args) -> None:
     from .learn.families import family
 
     try:
-        family(args.family)
+        topology = family(args.family).topology
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     out = _check_output(args.output, {".npz"})
     samples, dropped = generate(args.family, args.n, args.seed, nodes=args.nodes,
                                 workers=args.workers)
     save_dataset(out, samples, {"family": args.family, "seed": args.seed, "requested": args.n,
-                                "nodes": args.nodes, "dropped": dict(dropped)})
+                                "nodes": args.nodes, "dropped": dict(dropped),
+                                "topology": topology})
     reasons = ", ".join(f"{k}: {v}" for k, v in sorted(dropped.items())) or "none"
     print(f"{len(samples)} samples written to {out}; dropped {sum(dropped.values())} "
           f"({reasons})")

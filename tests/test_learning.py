@@ -159,3 +159,19 @@ def test_families_and_dataset_commands(tmp_path):
     assert load_dataset(out)[1]["samples"] >= 2
     bad = run_cli("dataset", "hexagonal", "-o", out)
     assert bad.returncode == 2 and "unknown family" in bad.stderr
+
+
+def test_topology_signatures_ignore_rotation_mirroring_and_order():
+    from quadcnn_wb.core.domain import domain_from_json
+    from quadcnn_wb.core.transform import similarity, transform_domain_json
+    from quadcnn_wb.infer.signature import topology_signature
+
+    rng = np.random.default_rng(4)
+    seen = {}
+    for name, fam in FAMILIES.items():
+        _, domain = fam.sample(rng)
+        moved = domain_from_json(transform_domain_json(domain.to_json(),
+                                                       similarity(33, 2.0, mirror=True)))
+        assert topology_signature(moved) == topology_signature(domain) == fam.topology
+        seen[fam.topology] = name
+    assert len(seen) == len(FAMILIES)  # every family has its own signature

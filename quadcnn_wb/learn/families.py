@@ -24,6 +24,12 @@ class Family:
     build: Callable[[dict], dict]  # parameters -> Domain JSON
     singularities: tuple  # (valence-3 count, valence-5 count) every member has
 
+    @property
+    def topology(self) -> str:
+        from ..infer.signature import topology_signature
+
+        return topology_signature(self.sample(np.random.default_rng(0))[1])
+
     def sample(self, rng: np.random.Generator) -> tuple[dict, Domain]:
         params = {k: float(rng.uniform(lo, hi)) for k, (lo, hi) in self.ranges.items()}
         return params, domain_from_json(self.build(params))
