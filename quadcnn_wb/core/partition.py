@@ -265,6 +265,8 @@ def _direction(points: np.ndarray, reach: float) -> np.ndarray:
     if n == 0:
         d = points[-1] - points[0]
         n = np.hypot(*d)
+    if n == 0:
+        raise PartitionError(f"a partition edge has zero length at {_fmt(points[0])}")
     return d / n
 
 
