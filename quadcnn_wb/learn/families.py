@@ -102,8 +102,8 @@ FAMILIES = {
     "four_hole": Family("four_hole", "rectangular plate with four circular holes, one per "
                         "quarter", {"width": (0.8, 1.25),
                                     **{f"{k}{i}{j}": rng for i in (0, 1) for j in (0, 1)
-                                       for k, rng in (("r", (0.06, 0.14)), ("x", (0.0, 1.0)),
-                                                      ("y", (0.0, 1.0)))}},
+                                       for k, rng in (("r", (0.08, 0.13)), ("x", (0.25, 0.75)),
+                                                      ("y", (0.25, 0.75)))}},
                         _four_hole, (0, 16)),
     "l_shape": Family("l_shape", "L-shaped plate (5 convex, 1 concave right-angle corner)",
                       {"width": (0.6, 2.0), "arm_x": (0.25, 0.75), "arm_y": (0.25, 0.75)},
