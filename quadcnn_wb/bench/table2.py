@@ -1,0 +1,51 @@
+"""The paper's Table 2 with our figures beside it:
+`python -m quadcnn_wb.bench.table2 [--samples 400] [--seed 9001] [MODEL.onnx ...]`.
+
+For each model (default: the shipped ones in resources/models), fresh test samples of its
+family are generated with a seed never used for training data, labelled by the numerical
+reference, and compared with the model's prediction (DESIGN.md metric definitions).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..infer.metrics import Confusion
+from ..infer.predictor import Predictor
+from ..learn.dataset import generate
+from .inference_speed import MODELS
+
+PAPER = {"concave": (0.852, 0.981), "four_hole": (0.821, 0.965)}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("models", nargs="*")
+    parser.add_argument("--samples", type=int, default=400)
+    parser.add_argument("--seed", type=int, default=9001)
+    parser.add_argument("--workers", type=int, default=None)
+    args = parser.parse_args(argv)
+    models = [Path(m) for m in args.models] or sorted(MODELS.glob("*.onnx"))
+    print("| topology | data size | IoU (paper) | accuracy (paper) | IoU (ours) | accuracy (ours) "
+          "| mIoU | all-zeros accuracy | test samples |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for model in models:
+        predictor = Predictor(model, threads=2)
+        family = predictor.metadata["family"]
+        samples, _ = generate(family, args.samples, args.seed, workers=args.workers,
+                              progress=False)
+        confusion = Confusion()
+        for sample in samples:
+            confusion.add(predictor.labels(sample.x), sample.y)
+        m = confusion.metrics(len(samples))
+        paper_iou, paper_acc = PAPER.get(family, ("–", "–"))
+        size = predictor.metadata.get("data", {}).get("samples", "?")
+        print(f"| {family} | {size} | {paper_iou} | {paper_acc} | {m['iou']:.3f} | "
+              f"{m['accuracy']:.3f} | {m['miou']:.3f} | {m['zero_baseline_accuracy']:.3f} | "
+              f"{m['samples']} |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
