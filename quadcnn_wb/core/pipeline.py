@@ -62,7 +62,7 @@ def default_size(domain: Domain) -> float:
 
 
 def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
-                method: str = "numerical") -> MeshResult:
+                method: str = "numerical", smoothing: bool = True) -> MeshResult:
     """Run the numerical path end to end."""
     if method not in ("numerical", "auto"):
         raise ValueError(f"method {method!r} is not available")
@@ -80,7 +80,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     counts = quantize(partition, size)
     timings["quantization"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    mesh = build_quad_mesh(domain, partition, counts)
+    mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
     timings["quad_mesh"] = time.perf_counter() - clock
     clock = time.perf_counter()
     quality = mesh_quality(domain, mesh)

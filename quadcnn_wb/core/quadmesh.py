@@ -56,7 +56,7 @@ def _polyline_points(points: np.ndarray, n: int) -> np.ndarray:
     return points[k] + f[:, None] * (points[k + 1] - points[k])
 
 
-def build_quad_mesh(domain, partition: Partition, counts) -> QuadMesh:
+def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True) -> QuadMesh:
     positions = [p for p in partition.vertices]
     boundary_ids = set()
     edge_nodes = []
@@ -107,7 +107,8 @@ def build_quad_mesh(domain, partition: Partition, counts) -> QuadMesh:
     boundary = np.zeros(len(nodes), dtype=bool)
     boundary[list(boundary_ids)] = True
     quads = _counter_clockwise(nodes, quads)
-    nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
+    if smoothing:
+        nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
                     edge_nodes=tuple(edge_nodes))
 

@@ -1,0 +1,142 @@
+"""FreeCAD geometry to a QuadCNN Domain and back: sketches and planar faces in any placement.
+
+A sketch's closed wires become a face (holes nested by FreeCAD's bullseye face maker); a
+face is taken as it is.  Coordinates go into the face's own plane (the sketch's placement
+for sketches), so the mesher sees a 2D domain; results go back through the same placement.
+Lines and circular arcs stay exact; B-splines, ellipses and other curves become polylines
+within CURVE_TOLERANCE of the part size.
+"""
+
+from __future__ import annotations
+
+import FreeCAD
+import numpy as np
+import Part
+
+from ..core.curves import Arc, Line
+from ..core.domain import DomainError, make_domain
+
+CURVE_TOLERANCE = 1e-4  # chordal deviation for curves that are not lines or arcs (x size)
+
+
+def source_shape_and_placement(source):
+    """(planar face, placement of its plane) for a sketch, a face feature or (obj, 'FaceN')."""
+    if isinstance(source, (tuple, list)):
+        obj, sub = source
+        face = obj.Shape.getElement(sub)
+        return face, _plane_placement(face, obj.Label)
+    if source.TypeId.startswith("Sketcher::SketchObject"):
+        return _sketch_face(source), source.getGlobalPlacement() \
+            if hasattr(source, "getGlobalPlacement") else source.Placement
+    shape = source.Shape
+    if not shape.Faces:
+        raise DomainError(f"{source.Label}: has no face to mesh")
+    face = shape.Faces[0]
+    return face, _plane_placement(face, source.Label)
+
+
+def _sketch_face(sketch):
+    shape = sketch.Shape
+    if shape.isNull() or not shape.Edges:
+        raise DomainError(f"{sketch.Label}: the sketch is empty")
+    wires = shape.Wires
+    loose = len(shape.Edges) - sum(len(w.Edges) for w in wires)
+    open_wires = [w for w in wires if not w.isClosed()]
+    if open_wires or loose:
+        raise DomainError(f"{sketch.Label}: the sketch has an open wire (every profile must "
+                          "be closed)")
+    try:
+        face = Part.makeFace(wires, "Part::FaceMakerBullseye")
+    except Exception as exc:
+        raise DomainError(f"{sketch.Label}: its wires do not make a face "
+                          f"({str(exc).strip() or type(exc).__name__})") from None
+    if len(face.Faces) != 1:
+        raise DomainError(f"{sketch.Label}: the sketch makes {len(face.Faces)} separate "
+                          "regions; QuadCNN meshes one region (with holes)")
+    return face.Faces[0]
+
+
+def _plane_placement(face, label):
+    surface = face.Surface
+    if not isinstance(surface, Part.Plane):
+        try:
+            plane = face.findPlane()
+        except Exception:
+            plane = None
+        if plane is None:
+            raise DomainError(f"{label}: the face is not planar")
+        surface = plane
+    normal = surface.Axis
+    if face.Orientation == "Reversed":
+        normal = normal.negative()
+    rotation = FreeCAD.Rotation(FreeCAD.Vector(0, 0, 1), normal)
+    return FreeCAD.Placement(surface.Position, rotation)
+
+
+def face_to_domain(face, placement, label="face", units="mm"):
+    """Domain in the plane's local coordinates; checks the face lies in that plane."""
+    inverse = placement.inverse()
+    size = face.BoundBox.DiagonalLength
+    tol = max(1e-7 * size, 1e-12)
+
+    def local(v):
+        p = inverse.multVec(v)
+        if abs(p.z) > 1e-6 * size:
+            raise DomainError(f"{label}: the face is not planar")
+        return (p.x, p.y)
+
+    loops = []
+    for wire in [face.OuterWire] + [w for w in face.Wires if not w.isSame(face.OuterWire)]:
+        loop = []
+        for edge in wire.OrderedEdges:
+            loop.extend(_edge_pieces(edge, local, tol, size))
+        loops.append(_chain(loop))
+    return make_domain(loops, units=units)
+
+
+def _edge_pieces(edge, local, tol, size):
+    curve = edge.Curve
+    first, last = edge.FirstParameter, edge.LastParameter
+    start, end = local(edge.valueAt(first)), local(edge.valueAt(last))
+    if isinstance(curve, (Part.Line, Part.LineSegment)):
+        return [Line(np.array(start), np.array(end))]
+    if isinstance(curve, Part.Circle):
+        if edge.isClosed():
+            c = local(curve.Center)
+            return [Arc.circle(np.array(c), curve.Radius)]
+        mid = local(edge.valueAt(0.5 * (first + last)))
+        return [(np.array(start), np.array(mid), np.array(end))]
+    points = [local(p) for p in edge.discretize(Deflection=CURVE_TOLERANCE * size)]
+    if edge.isClosed() and len(points) > 2 and np.hypot(*np.subtract(points[0], points[-1])) \
+            <= tol:
+        points[-1] = points[0]
+    return [Line(np.array(a), np.array(b)) for a, b in zip(points[:-1], points[1:])
+            if np.hypot(*np.subtract(a, b)) > tol]
+
+
+def _chain(pieces):
+    """Orient the pieces of one wire so each starts where the previous ended."""
+    def ends(p):
+        return (p[0], p[2]) if isinstance(p, tuple) else (p.p0, p.p1)
+
+    def flip(p):
+        return (p[2], p[1], p[0]) if isinstance(p, tuple) else p.reversed()
+
+    if len(pieces) < 2:
+        return pieces
+    out = [pieces[0]]
+    a0, b0 = ends(pieces[0])
+    a1, b1 = ends(pieces[1])
+    if min(np.hypot(*(a0 - a1)), np.hypot(*(a0 - b1))) < min(np.hypot(*(b0 - a1)),
+                                                              np.hypot(*(b0 - b1))):
+        out[0] = flip(pieces[0])
+    for p in pieces[1:]:
+        end = ends(out[-1])[1]
+        a, b = ends(p)
+        out.append(p if np.hypot(*(a - end)) <= np.hypot(*(b - end)) else flip(p))
+    return out
+
+
+def to_global(placement, xy):
+    """FreeCAD vectors of 2D points in the source plane."""
+    return [placement.multVec(FreeCAD.Vector(float(x), float(y), 0.0)) for x, y in xy]

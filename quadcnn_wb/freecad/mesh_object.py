@@ -1,0 +1,143 @@
+"""The QuadCNN mesh as a FreeCAD document object: a Fem::FemMeshObjectPython whose proxy
+runs the pipeline on its source sketch or face at every recompute.
+
+No GUI code here (FreeCAD FEM layout: proxies hold logic, view providers live apart).  A
+failing regeneration prints the reason with the object's name, sets Status, and raises,
+which FreeCAD turns into an invalid-marked object; the FemMesh of the last good run is
+left untouched, so a breaking design edit never loses the mesh.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+import FreeCAD
+
+PROPERTIES = (
+    # (type, name, group, tooltip)
+    ("App::PropertyLinkSub", "Source", "QuadCNN", "Sketch or planar face to mesh"),
+    ("App::PropertyEnumeration", "Method", "QuadCNN",
+     "How streamlines are found: auto (a matching model, else numerical), cnn, numerical"),
+    ("App::PropertyFileIncluded", "Model", "QuadCNN",
+     "ONNX model embedded in the document (cnn method)"),
+    ("App::PropertyString", "ModelEntry", "QuadCNN", "Registry entry the model came from"),
+    ("App::PropertyInteger", "TargetNodes", "QuadCNN", "Background mesh node count"),
+    ("App::PropertyLength", "ElementSize", "QuadCNN",
+     "Target quad size (0: the source's diagonal / 40)"),
+    ("App::PropertyBool", "Smoothing", "QuadCNN", "Smooth the mesh after the block maps"),
+    ("App::PropertyLink", "StreamlineWires", "QuadCNN", "Companion: streamlines as wires"),
+    ("App::PropertyLink", "BlockFaces", "QuadCNN", "Companion: the blocks as faces"),
+    ("App::PropertyInteger", "Blocks", "Results", "Number of blocks"),
+    ("App::PropertyInteger", "Quads", "Results", "Number of quadrilaterals"),
+    ("App::PropertyInteger", "Singularities", "Results", "Singular points of the field"),
+    ("App::PropertyFloat", "MinScaledJacobian", "Results", "Worst element quality"),
+    ("App::PropertyInteger", "IrregularVertices", "Results", "Irregular vertices"),
+    ("App::PropertyString", "MethodUsed", "Results", "Method that produced the mesh"),
+    ("App::PropertyIntegerList", "Fallbacks", "Results",
+     "Streamlines the cnn path had to trace numerically"),
+    ("App::PropertyString", "Timings", "Results", "Seconds per stage (JSON)"),
+    ("App::PropertyString", "Status", "Results", "ok, or what went wrong last time"),
+)
+READ_ONLY = ("Blocks", "Quads", "Singularities", "MinScaledJacobian", "IrregularVertices",
+             "MethodUsed", "Fallbacks", "Timings", "Status")
+DEFAULTS = {"Method": ["auto", "cnn", "numerical"], "TargetNodes": 2048, "Smoothing": True}
+
+
+def add_properties(obj) -> None:
+    """Declare every property once; safe to call again (on restore, after upgrades)."""
+    for kind, name, group, tip in PROPERTIES:
+        if name in obj.PropertiesList:
+            continue
+        obj.addProperty(kind, name, group, tip)
+        if name in DEFAULTS:
+            setattr(obj, name, DEFAULTS[name])
+        if name in READ_ONLY:
+            obj.setEditorMode(name, 1)
+
+
+class QuadMeshProxy:
+    Type = "QuadCNN::QuadMesh"
+
+    def __init__(self, obj):
+        obj.Proxy = self
+        add_properties(obj)
+
+    def onDocumentRestored(self, obj):
+        add_properties(obj)
+
+    # FreeCAD 0.20 pickles proxies with __getstate__/__setstate__, 0.21+ with dumps/loads.
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def execute(self, obj):
+        from ..core.domain import DomainError
+        from ..core.pipeline import mesh_domain
+        from .geometry import face_to_domain, source_shape_and_placement
+        from .mesh_builder import fem_mesh, update_companions
+
+        started = time.perf_counter()
+        try:
+            source = _source_of(obj)
+            face, placement = source_shape_and_placement(source)
+            label = source[0].Label if isinstance(source, tuple) else source.Label
+            domain = face_to_domain(face, placement, label)
+            if obj.Method == "cnn":
+                raise ValueError("the cnn method needs trained models, which this version "
+                                 "does not ship yet; use auto or numerical")
+            size = float(obj.ElementSize) or None
+            result = mesh_domain(domain, size=size, nodes=int(obj.TargetNodes),
+                                 smoothing=bool(obj.Smoothing))
+        except (DomainError, ValueError, RuntimeError) as exc:
+            message = " ".join(str(exc).split())
+            obj.Status = f"error: {message}"
+            FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
+            raise RuntimeError(f"{obj.Label}: {message}") from None
+        obj.FemMesh = fem_mesh(result, placement)
+        update_companions(obj, result, placement)
+        q = result.quality
+        obj.Blocks, obj.Quads = q["blocks"], q["quads"]
+        obj.Singularities = len(result.reference.field.singularities)
+        obj.MinScaledJacobian = q["min_scaled_jacobian"]
+        obj.IrregularVertices = q["irregular_vertices"]
+        obj.MethodUsed = result.method
+        obj.Fallbacks = list(result.fallback)
+        obj.Timings = json.dumps({k: round(v, 4) for k, v in result.timings.items()})
+        obj.Status = "ok"
+        FreeCAD.Console.PrintLog(f"{obj.Label}: {q['quads']} quads in "
+                                 f"{time.perf_counter() - started:.2f} s\n")
+
+
+def _source_of(obj):
+    link = obj.Source
+    if link is None or link[0] is None:
+        raise ValueError("no source: link a sketch or a planar face")
+    target, subs = link
+    subs = [s for s in (subs or []) if s]
+    if subs:
+        return (target, subs[0])
+    return target
+
+
+def make_quad_mesh(doc, source, name: str = "QuadMesh", **properties):
+    """A QuadCNN mesh object for a sketch, a face feature, or (object, 'FaceN')."""
+    obj = doc.addObject("Fem::FemMeshObjectPython", name)
+    QuadMeshProxy(obj)
+    if isinstance(source, (tuple, list)):
+        obj.Source = (source[0], [source[1]])
+    else:
+        obj.Source = (source, [])
+    for key, value in properties.items():
+        setattr(obj, key, value)
+    obj.StreamlineWires = doc.addObject("Part::Feature", f"{obj.Name}_Streamlines")
+    obj.BlockFaces = doc.addObject("Part::Feature", f"{obj.Name}_Blocks")
+    return obj
