@@ -1,0 +1,132 @@
+"""The parametric QuadMesh object in a real FreeCAD: creation from sketches and faces in any
+placement, following design edits, keeping the last mesh on a breaking edit, save/reload."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import unittest
+
+import FreeCAD
+import Part
+import Sketcher
+
+from quadcnn_wb.freecad import make_quad_mesh
+
+V = FreeCAD.Vector
+
+
+def plate_sketch(doc, placement):
+    """A 40 x 20 plate with a radius-5 hole; returns (sketch, width constraint, radius one)."""
+    sk = doc.addObject("Sketcher::SketchObject", "Plate")
+    sk.Placement = placement
+    pts = [V(0, 0, 0), V(40, 0, 0), V(40, 20, 0), V(0, 20, 0)]
+    for a, b in zip(pts, pts[1:] + pts[:1]):
+        sk.addGeometry(Part.LineSegment(a, b))
+    for i in range(4):
+        sk.addConstraint(Sketcher.Constraint("Coincident", i, 2, (i + 1) % 4, 1))
+    for i, kind in enumerate(("Horizontal", "Vertical", "Horizontal", "Vertical")):
+        sk.addConstraint(Sketcher.Constraint(kind, i))
+    sk.addConstraint(Sketcher.Constraint("Coincident", 0, 1, -1, 1))
+    width = sk.addConstraint(Sketcher.Constraint("DistanceX", 0, 1, 0, 2, 40))
+    sk.addConstraint(Sketcher.Constraint("DistanceY", 1, 1, 1, 2, 20))
+    sk.addGeometry(Part.Circle(V(20, 10, 0), V(0, 0, 1), 5))
+    radius = sk.addConstraint(Sketcher.Constraint("Radius", 4, 5))
+    doc.recompute()
+    return sk, width, radius
+
+
+class TestQuadMeshObject(unittest.TestCase):
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("QuadCNNTest")
+        self.placement = FreeCAD.Placement(V(10, -5, 3), FreeCAD.Rotation(V(1, 1, 0), 30))
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_sketch_in_a_rotated_offset_placement(self):
+        sk, _, _ = plate_sketch(self.doc, self.placement)
+        mesh = make_quad_mesh(self.doc, sk)
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        self.assertEqual(mesh.Status, "ok")
+        self.assertEqual(mesh.FemMesh.FaceCount, mesh.Quads)
+        self.assertEqual(mesh.Singularities, 4)
+        self.assertEqual(mesh.IrregularVertices, 4)
+        self.assertGreater(mesh.MinScaledJacobian, 0.5)
+        inverse = sk.Placement.inverse()
+        local = [inverse.multVec(v) for v in mesh.FemMesh.Nodes.values()]
+        self.assertLess(max(abs(p.z) for p in local), 1e-9)  # nodes lie in the sketch plane
+        self.assertAlmostEqual(min(p.x for p in local), 0.0, places=9)
+        self.assertAlmostEqual(max(p.x for p in local), 40.0, places=9)
+        names = [mesh.FemMesh.getGroupName(g) for g in mesh.FemMesh.Groups]
+        self.assertIn("Block0", names)
+        self.assertIn("LOOP1", names)  # the hole's boundary nodes, for FEM constraints
+        self.assertFalse(mesh.StreamlineWires.Shape.isNull())
+        self.assertEqual(len(mesh.BlockFaces.Shape.Faces), mesh.Blocks)
+
+    def test_follows_set_datum_and_keeps_the_last_mesh_on_a_breaking_edit(self):
+        sk, width, radius = plate_sketch(self.doc, self.placement)
+        mesh = make_quad_mesh(self.doc, sk, ElementSize=2.0)
+        self.doc.recompute()
+        before = mesh.Quads
+        sk.setDatum(width, FreeCAD.Units.Quantity("60 mm"))
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        self.assertGreater(mesh.Quads, before)  # same element size, larger plate
+        widened = mesh.Quads
+        sk.setDatum(radius, FreeCAD.Units.Quantity("15 mm"))  # hole cuts the plate's edges
+        self.doc.recompute()
+        self.assertFalse(mesh.isValid())
+        self.assertIn("intersect", mesh.Status)
+        self.assertEqual(mesh.FemMesh.FaceCount, widened)  # last good mesh kept
+        sk.setDatum(radius, FreeCAD.Units.Quantity("5 mm"))
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        self.assertEqual(mesh.Quads, widened)
+
+    def test_face_of_a_partdesign_body(self):
+        body = self.doc.addObject("PartDesign::Body", "Body")
+        box = self.doc.addObject("PartDesign::AdditiveBox", "Box")
+        body.addObject(box)
+        box.Length, box.Width, box.Height = 30, 10, 5
+        body.Placement = self.placement
+        self.doc.recompute()
+        top = max(range(len(box.Shape.Faces)), key=lambda i: box.Shape.Faces[i].Area)
+        mesh = make_quad_mesh(self.doc, (box, f"Face{top + 1}"), ElementSize=2.5)
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        self.assertEqual(mesh.Quads, 12 * 4)  # a 30 x 10 rectangle at size 2.5
+        self.assertEqual(mesh.IrregularVertices, 0)
+        face = box.Shape.Faces[top]
+        for node in list(mesh.FemMesh.Nodes.values())[:20]:
+            self.assertLess(face.distToShape(Part.Vertex(node))[0], 1e-7)
+
+    def test_open_sketch_is_refused_with_a_message(self):
+        sk = self.doc.addObject("Sketcher::SketchObject", "Open")
+        sk.addGeometry(Part.LineSegment(V(0, 0, 0), V(10, 0, 0)))
+        sk.addGeometry(Part.LineSegment(V(10, 0, 0), V(10, 10, 0)))
+        self.doc.recompute()
+        mesh = make_quad_mesh(self.doc, sk)
+        self.doc.recompute()
+        self.assertFalse(mesh.isValid())
+        self.assertIn("open wire", mesh.Status)
+
+    def test_save_close_reopen_and_regenerate(self):
+        sk, width, _ = plate_sketch(self.doc, self.placement)
+        mesh = make_quad_mesh(self.doc, sk, Method="numerical", TargetNodes=1500)
+        self.doc.recompute()
+        quads, name, sketch_name = mesh.Quads, mesh.Name, sk.Name
+        path = os.path.join(tempfile.mkdtemp(), "plate.FCStd")
+        self.doc.saveAs(path)
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        again = self.doc.getObject(name)
+        self.assertEqual(type(again.Proxy).__name__, "QuadMeshProxy")
+        self.assertEqual((again.Quads, again.FemMesh.FaceCount), (quads, quads))
+        self.assertEqual((again.Method, again.TargetNodes), ("numerical", 1500))
+        sketch = self.doc.getObject(sketch_name)
+        sketch.setDatum(width, FreeCAD.Units.Quantity("50 mm"))
+        self.doc.recompute()
+        self.assertTrue(again.isValid(), again.Status)
+        self.assertNotEqual(again.Quads, quads)
