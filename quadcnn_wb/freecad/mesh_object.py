@@ -61,9 +61,11 @@ class QuadMeshProxy:
 
     def __init__(self, obj):
         obj.Proxy = self
+        self.last_result = None  # the latest MeshResult, in memory only (not saved)
         add_properties(obj)
 
     def onDocumentRestored(self, obj):
+        self.last_result = None
         add_properties(obj)
 
     # FreeCAD 0.20 pickles proxies with __getstate__/__setstate__, 0.21+ with dumps/loads.
@@ -86,6 +88,8 @@ class QuadMeshProxy:
         from .mesh_builder import fem_mesh, update_companions
 
         started = time.perf_counter()
+        progress = FreeCAD.Base.ProgressIndicator()
+        progress.start(f"QuadCNN: meshing {obj.Label}", 0)
         try:
             source = _source_of(obj)
             face, placement = source_shape_and_placement(source)
@@ -102,6 +106,9 @@ class QuadMeshProxy:
             obj.Status = f"error: {message}"
             FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
             raise RuntimeError(f"{obj.Label}: {message}") from None
+        finally:
+            progress.stop()
+        self.last_result = result
         obj.FemMesh = fem_mesh(result, placement)
         update_companions(obj, result, placement)
         q = result.quality
