@@ -55,7 +55,10 @@ demo: setup
 	    -o $(OUT)/four_hole_mesh.json --png $(OUT)/four_hole_mesh.png
 	$(PY) -m quadcnn_wb mesh resources/examples/four_hole.json --method numerical \
 	    -o $(OUT)/four_hole_mesh.inp
+	QUADCNN_OUT=$(OUT) freecadcmd quadcnn_wb/freecad/demo.py
 	@echo "wrote $(OUT)/four_hole_{background,field,mesh}.png, their .json and four_hole_mesh.inp"
+	@echo "and, from headless FreeCAD, $(OUT)/plate_design.FCStd (edited and regenerated),"
+	@echo "plate_design_mesh.inp and plate_design_mesh.png"
 
 lint: setup
 	$(VENV)/bin/ruff check .
