@@ -2,7 +2,7 @@
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
-APT_PACKAGES := freecad-python3 xvfb xauth
+APT_PACKAGES := freecad-python3 xvfb xauth calculix-ccx
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed

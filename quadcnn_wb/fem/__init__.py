@@ -1,0 +1,1 @@
+"""Finite-element use of the quad meshes (CalculiX), to show they work for analysis."""
