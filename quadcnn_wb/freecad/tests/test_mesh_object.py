@@ -130,3 +130,44 @@ class TestQuadMeshObject(unittest.TestCase):
         self.doc.recompute()
         self.assertTrue(again.isValid(), again.Status)
         self.assertNotEqual(again.Quads, quads)
+
+
+class TestQuadMeshDocument(unittest.TestCase):
+    def setUp(self):
+        self.doc = FreeCAD.newDocument("QuadCNNDoc")
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_embedded_model_survives_save_and_reload(self):
+        import hashlib
+
+        sk, _, _ = plate_sketch(self.doc, FreeCAD.Placement())
+        folder = tempfile.mkdtemp()
+        model = os.path.join(folder, "family.onnx")
+        with open(model, "wb") as handle:
+            handle.write(b"ONNX model bytes stand-in " * 100)  # the property embeds any file
+        digest = hashlib.sha256(open(model, "rb").read()).hexdigest()
+        mesh = make_quad_mesh(self.doc, sk, Model=model, ModelEntry="user:family")
+        self.doc.recompute()
+        name = mesh.Name
+        path = os.path.join(folder, "with_model.FCStd")
+        self.doc.saveAs(path)
+        os.remove(model)  # the document must not depend on the original file
+        FreeCAD.closeDocument(self.doc.Name)
+        self.doc = FreeCAD.openDocument(path)
+        again = self.doc.getObject(name)
+        self.assertEqual(again.ModelEntry, "user:family")
+        self.assertTrue(os.path.isfile(again.Model))
+        self.assertEqual(hashlib.sha256(open(again.Model, "rb").read()).hexdigest(), digest)
+
+    def test_ellipse_sketch_is_approximated_and_meshed(self):
+        sk = self.doc.addObject("Sketcher::SketchObject", "Ellipse")
+        sk.addGeometry(Part.Ellipse(V(0, 0, 0), 30, 12))
+        self.doc.recompute()
+        mesh = make_quad_mesh(self.doc, sk, ElementSize=2.0)
+        self.doc.recompute()
+        self.assertTrue(mesh.isValid(), mesh.Status)
+        self.assertEqual(mesh.IrregularVertices, mesh.Singularities)
+        area = sum(f.Area for f in mesh.BlockFaces.Shape.Faces)
+        self.assertAlmostEqual(area / (3.141592653589793 * 30 * 12), 1.0, delta=0.01)
