@@ -20,19 +20,26 @@ CURVE_TOLERANCE = 1e-4  # chordal deviation for curves that are not lines or arc
 
 
 def source_shape_and_placement(source):
-    """(planar face, placement of its plane) for a sketch, a face feature or (obj, 'FaceN')."""
+    """(planar face, its plane in the shape's coordinates, that plane in global coordinates).
+
+    Shapes of features inside a Body (or any container) are in the container's
+    coordinates; the global plane adds the container's placement, so results land where
+    the user sees the source.
+    """
     if isinstance(source, (tuple, list)):
         obj, sub = source
         face = obj.Shape.getElement(sub)
-        return face, _plane_placement(face, obj.Label)
-    if source.TypeId.startswith("Sketcher::SketchObject"):
-        return _sketch_face(source), source.getGlobalPlacement() \
-            if hasattr(source, "getGlobalPlacement") else source.Placement
-    shape = source.Shape
-    if not shape.Faces:
-        raise DomainError(f"{source.Label}: has no face to mesh")
-    face = shape.Faces[0]
-    return face, _plane_placement(face, source.Label)
+        plane = _plane_placement(face, obj.Label)
+    elif source.TypeId.startswith("Sketcher::SketchObject"):
+        obj, face, plane = source, _sketch_face(source), source.Placement
+    else:
+        obj = source
+        if not source.Shape.Faces:
+            raise DomainError(f"{source.Label}: has no face to mesh")
+        face = source.Shape.Faces[0]
+        plane = _plane_placement(face, source.Label)
+    container = obj.getGlobalPlacement().multiply(obj.Placement.inverse())
+    return face, plane, container.multiply(plane)
 
 
 def _sketch_face(sketch):

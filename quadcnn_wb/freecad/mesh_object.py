@@ -92,9 +92,9 @@ class QuadMeshProxy:
         progress.start(f"QuadCNN: meshing {obj.Label}", 0)
         try:
             source = _source_of(obj)
-            face, placement = source_shape_and_placement(source)
+            face, plane, placement = source_shape_and_placement(source)
             label = source[0].Label if isinstance(source, tuple) else source.Label
-            domain = face_to_domain(face, placement, label)
+            domain = face_to_domain(face, plane, label)
             if obj.Method == "cnn":
                 raise ValueError("the cnn method needs trained models, which this version "
                                  "does not ship yet; use auto or numerical")

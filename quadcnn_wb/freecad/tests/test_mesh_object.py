@@ -98,7 +98,8 @@ class TestQuadMeshObject(unittest.TestCase):
         self.assertTrue(mesh.isValid(), mesh.Status)
         self.assertEqual(mesh.Quads, 12 * 4)  # a 30 x 10 rectangle at size 2.5
         self.assertEqual(mesh.IrregularVertices, 0)
-        face = box.Shape.Faces[top]
+        face = box.Shape.Faces[top].copy()
+        face.Placement = body.Placement.multiply(face.Placement)  # the body-local face, placed
         for node in list(mesh.FemMesh.Nodes.values())[:20]:
             self.assertLess(face.distToShape(Part.Vertex(node))[0], 1e-7)
 
@@ -171,3 +172,25 @@ class TestQuadMeshDocument(unittest.TestCase):
         self.assertEqual(mesh.IrregularVertices, mesh.Singularities)
         area = sum(f.Area for f in mesh.BlockFaces.Shape.Faces)
         self.assertAlmostEqual(area / (3.141592653589793 * 30 * 12), 1.0, delta=0.01)
+
+
+class TestSketchInBody(unittest.TestCase):
+    def test_sketch_inside_a_placed_body_meshes_in_global_coordinates(self):
+        doc = FreeCAD.newDocument("QuadCNNBody")
+        try:
+            body = doc.addObject("PartDesign::Body", "Body")
+            body.Placement = FreeCAD.Placement(V(100, 20, 0), FreeCAD.Rotation(V(0, 0, 1), 90))
+            sk, _, _ = plate_sketch(doc, FreeCAD.Placement(V(0, 0, 50), FreeCAD.Rotation()))
+            body.addObject(sk)
+            doc.recompute()
+            mesh = make_quad_mesh(doc, sk, ElementSize=2.0)
+            doc.recompute()
+            self.assertTrue(mesh.isValid(), mesh.Status)
+            inverse = sk.getGlobalPlacement().inverse()
+            local = [inverse.multVec(v) for v in mesh.FemMesh.Nodes.values()]
+            self.assertLess(max(abs(p.z) for p in local), 1e-9)
+            self.assertAlmostEqual(max(p.x for p in local), 40.0, places=9)
+            zs = {round(v.z, 9) for v in mesh.FemMesh.Nodes.values()}
+            self.assertEqual(zs, {50.0})
+        finally:
+            FreeCAD.closeDocument(doc.Name)
