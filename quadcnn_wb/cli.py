@@ -26,14 +26,22 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"error: {message} (see '{self.prog} --help')\n")
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 8:
-        raise argparse.ArgumentTypeError(f"expected at least 8, got {value}")
-    return value
+def _whole_number(minimum: int):
+    """argparse type: an integer of at least ``minimum``."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"expected at least {minimum}, got {value}")
+        return value
+
+    return parse
+
+
+_positive_int = _whole_number(8)  # node counts
+_positive_count = _whole_number(1)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -107,16 +115,6 @@ def _stage_parser(commands, name, summary, nodes_help, output_help, png_help):
     sub.add_argument("-o", "--output", help=output_help)
     sub.add_argument("--png", help=png_help)
     return sub
-
-
-def _positive_count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected at least 1, got {value}")
-    return value
 
 
 def _positive_float(text: str) -> float:
