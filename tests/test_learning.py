@@ -12,7 +12,7 @@ from conftest import run_cli
 
 from quadcnn_wb.core.partition import build_partition
 from quadcnn_wb.core.reference import numerical_reference
-from quadcnn_wb.infer.encoding import canonical_angle, encode
+from quadcnn_wb.infer.encoding import canonical_angle, encode, swap_labels
 from quadcnn_wb.infer.predictor import ModelError, Predictor
 from quadcnn_wb.learn.dataset import generate, load_dataset, make_sample, save_dataset
 from quadcnn_wb.learn.families import FAMILIES
@@ -41,19 +41,38 @@ def test_samples_are_deterministic_and_normalised():
     assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
     other, _ = make_sample("l_shape", seed=5, index=4, nodes=800)
     assert not np.array_equal(a.x[:50], other.x[:50])
-    lo, hi = a.x[:, :2].min(axis=0), a.x[:, :2].max(axis=0)
-    assert np.isclose(np.hypot(*(hi - lo)), 1.0, atol=0.02)  # unit diagonal (after bending)
+    radius = np.hypot(a.x[:, 0], a.x[:, 1])
+    assert 0.3 < radius.max() <= 0.5 + 1e-6  # inside the unit-diagonal box's circle
     assert np.allclose(np.hypot(a.x[:, 2], a.x[:, 3]), 1.0, atol=1e-6)
     angle = np.arctan2(a.x[:, 3], a.x[:, 2])
     assert np.all(angle > -np.pi / 4 - 1e-6) and np.all(angle <= np.pi / 4 + 1e-6)
     assert 0 < a.y.mean() < 0.2 and set(np.unique(a.y)) == {0, 1}
 
 
-def test_encoding_ignores_placement_and_scale():
-    nodes = np.random.default_rng(0).uniform(size=(50, 2))
-    theta = np.random.default_rng(1).uniform(-3, 3, size=50)
-    assert np.allclose(encode(nodes, theta), encode(nodes * 1e4 + 7, theta), atol=1e-6)
+def test_encoding_ignores_placement_scale_and_rotation():
+    rng = np.random.default_rng(0)
+    nodes = rng.uniform(size=(50, 2))
+    theta = 0.3 + rng.normal(scale=0.1, size=50)
+    base, swapped = encode(nodes, theta)
+    assert not swapped.any()
+    moved, _ = encode(nodes * 1e4 + 7, theta)
+    assert np.allclose(base, moved, atol=1e-5)
+    # A rotated copy (the crosses turn with it) gives the same input up to the bbox centre.
+    a = 0.5
+    rot = nodes @ np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+    turned, _ = encode(rot, theta + a)
+    assert np.allclose(turned[:, 2:], base[:, 2:], atol=1e-6)
+    d_base = base[:, :2] - base[:, :2].mean(axis=0)
+    d_turned = turned[:, :2] - turned[:, :2].mean(axis=0)
+    scale = np.linalg.norm(d_base) / np.linalg.norm(d_turned)
+    quarter = np.array([[0.0, -1.0], [1.0, 0.0]])
+    matches = [np.allclose(d_turned @ np.linalg.matrix_power(quarter, k) * scale, d_base,
+                           atol=1e-5) for k in range(4)]
+    assert any(matches)  # the same input up to a quarter turn
     assert np.allclose(canonical_angle(theta + np.pi / 2), canonical_angle(theta), atol=1e-9)
+    labels = rng.integers(0, 2, size=(50, 2))
+    mask = rng.random(50) < 0.5
+    assert np.array_equal(swap_labels(swap_labels(labels, mask), mask), labels)
 
 
 def test_network_shapes_and_parameter_count():

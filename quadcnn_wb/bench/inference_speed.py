@@ -39,7 +39,7 @@ def main(argv=None) -> int:
         models = [Path(tempfile.mkdtemp()) / "untrained.onnx"]
         export_onnx(QuadCNN(), models[0])
     ref = numerical_reference(load_domain(EXAMPLES / "four_hole.json"), labels=False)
-    x = encode(ref.mesh.nodes, ref.field.theta)
+    x, _ = encode(ref.mesh.nodes, ref.field.theta)
     print(f"one sample of {len(x)} points (four_hole)")
     for model in models:
         for threads in (1, 2):

@@ -27,7 +27,7 @@ from ..core.domain import domain_from_json
 from ..core.partition import PartitionError, build_partition
 from ..core.reference import numerical_reference
 from ..core.transform import similarity, transform_domain_json
-from ..infer.encoding import ENCODING, encode
+from ..infer.encoding import ENCODING, encode, swap_labels
 from .augment import jitter_nodes, smooth_deformation
 from .families import family
 
@@ -64,7 +64,8 @@ def make_sample(family_name: str, seed: int, index: int, nodes: int = 2048):
     except PartitionError:
         return None, "partition not four-sided"
     nodes_xy, theta, labels = smooth_deformation(mesh.nodes, ref.field.theta, ref.labels, rng)
-    return Sample(x=encode(nodes_xy, theta), y=labels.astype(np.uint8)), None
+    x, swapped = encode(nodes_xy, theta)
+    return Sample(x=x, y=swap_labels(labels, swapped).astype(np.uint8)), None
 
 
 def _work(args):
