@@ -11,6 +11,7 @@ vectorised, so tracing a whole field costs about as much as tracing one.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -60,6 +61,7 @@ class Streamline:
     end: Endpoint
     capped: bool = False
     start_direction: np.ndarray = field(default=None, compare=False)
+    fallback: bool = False  # traced numerically because the cnn reconstruction failed
 
     @property
     def length(self) -> float:
@@ -389,10 +391,7 @@ def _arrival_branches(lines, h):
             d = float(tree.query(near[1:])[0].mean())
             if d < best_dist:
                 best, best_dist = branch, d
-        out.append(Streamline(points=line.points, start=line.start,
-                              end=Endpoint(end.kind, end.index, end.loop, end.segment,
-                                           end.param, best),
-                              capped=line.capped, start_direction=line.start_direction))
+        out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
     return out
 
 
@@ -406,9 +405,8 @@ def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> St
         return line
     head = int(close[0])
     point, param = _nearest_on_polyline(other.points, line.points[head])
-    return Streamline(points=np.vstack([line.points[:head], point]), start=line.start,
-                      end=Endpoint("streamline", other_index, param=param),
-                      capped=line.capped, start_direction=line.start_direction)
+    return dataclasses.replace(line, points=np.vstack([line.points[:head], point]),
+                               end=Endpoint("streamline", other_index, param=param))
 
 
 def _densify(points, spacing):
