@@ -38,8 +38,13 @@ class MeshWalker:
         self.neighbours = triangle_neighbours(triangles)
         a, b, c = (nodes[triangles[:, k]] for k in range(3))
         self.origin = a
-        m = np.stack([b - a, c - a], axis=2)  # columns: edge vectors
-        self.inverse = np.linalg.inv(m)
+        # Inverse of the 2x2 matrix with the edge vectors as columns, in closed form
+        # (np.linalg.inv on thousands of tiny matrices costs more than the whole walk).
+        e1, e2 = b - a, c - a
+        det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        self.inverse = np.stack([np.stack([e2[:, 1], -e2[:, 0]], axis=1),
+                                 np.stack([-e1[:, 1], e1[:, 0]], axis=1)], axis=1) / det[:, None,
+                                                                                         None]
 
     def barycentric(self, tri: np.ndarray, p: np.ndarray) -> np.ndarray:
         uv = np.einsum("nij,nj->ni", self.inverse[tri], p - self.origin[tri])
