@@ -17,7 +17,8 @@ help:
 	@echo "make demo   - set up, then mesh a bundled example and write pictures to $(OUT)/"
 	@echo "make test   - set up, then run ruff and the whole test suite"
 	@echo "make setup  - install what is missing (Debian packages, $(VENV), FreeCAD Mod link)"
-	@echo "make bench  - print background, field and tracing times"
+	@echo "make bench  - print speed and quality figures (background, field, mesh vs gmsh,"
+	@echo "              onnxruntime inference, CalculiX plate-with-hole check)"
 
 setup: system-packages $(STAMP) link
 
@@ -71,6 +72,8 @@ bench: setup
 	$(PY) -m quadcnn_wb.bench.background_speed
 	$(PY) -m quadcnn_wb.bench.field_speed
 	$(PY) -m quadcnn_wb.bench.mesh_vs_gmsh
+	$(PY) -m quadcnn_wb.bench.inference_speed
+	$(PY) -m quadcnn_wb.fem.plate_tension
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache
