@@ -2,7 +2,8 @@
 
 How the inconsistencies of Table 1 are resolved here:
 - Input: one point per background node, (x, y, v1x, v1y) (see infer.encoding); Table 1's
-  [B, 2048, 4] read literally.  Output: two logits per point, the labels of v1 and v2
+  [B, 2048, 4] read literally.  Inside, a fixed layer adds (cos 4t, sin 4t) of the frame
+  angle (see with_quartic), so the first stages see 6 channels.  Output: two logits per point, the labels of v1 and v2
   (Table 1's [B, 2048, 2]); a sigmoid makes them probabilities (in the loss, and in the
   exported ONNX graph).
 - EdgeConv (Wang et al., DGCNN): edge features [x_j - x_i, x_i] over the k = 10 nearest
@@ -62,13 +63,26 @@ def _pointwise(cin: int, cout: int) -> nn.Sequential:
                          nn.LeakyReLU(0.2))
 
 
+def with_quartic(x: torch.Tensor) -> torch.Tensor:
+    """(B, N, 4) -> (B, N, 6): adds cos 4t and sin 4t of the frame angle t.
+
+    v1 = (cos t, sin t) jumps by a quarter turn wherever t crosses ±45°, lines that mean
+    nothing; (cos 4t, sin 4t) is the same for the whole cross and smooth except at the
+    singular points, where it winds — the structure the network has to find.
+    """
+    c, s = x[..., 2], x[..., 3]
+    cos4 = 1.0 - 8.0 * c * c * s * s
+    sin4 = 4.0 * c * s * (c * c - s * s)
+    return torch.cat([x, cos4.unsqueeze(-1), sin4.unsqueeze(-1)], dim=-1)
+
+
 class QuadCNN(nn.Module):
     def __init__(self, k: int = K_NEIGHBOURS, widths=STAGE_WIDTHS, dropout: float = 0.5):
         super().__init__()
         self.k = k
         self.edge = nn.ModuleList()
         self.point = nn.ModuleList()
-        cin = 4
+        cin = 6
         for w in widths:
             self.edge.append(EdgeConv(cin, w))
             self.point.append(_pointwise(cin, w))
@@ -88,7 +102,7 @@ class QuadCNN(nn.Module):
         if idx is None:
             with torch.no_grad():
                 idx = knn(x[..., :2], self.k)
-        h = x.transpose(1, 2)
+        h = with_quartic(x).transpose(1, 2)
         stages = []
         for edge, point in zip(self.edge, self.point):
             h = torch.cat([edge(h, idx), point(h)], dim=1)
