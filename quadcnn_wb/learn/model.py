@@ -3,9 +3,9 @@
 How the inconsistencies of Table 1 are resolved here:
 - Input: one point per background node, (x, y, v1x, v1y) (see infer.encoding); Table 1's
   [B, 2048, 4] read literally.  Inside, a fixed layer adds (cos 4t, sin 4t) of the frame
-  angle (see with_quartic), so the first stages see 6 channels.  Output: two logits per point, the labels of v1 and v2
-  (Table 1's [B, 2048, 2]); a sigmoid makes them probabilities (in the loss, and in the
-  exported ONNX graph).
+  angle (see with_quartic), so the first stages see 6 channels.  Output: two logits per
+  point, the labels of v1 and v2 (Table 1's [B, 2048, 2]); a sigmoid makes them
+  probabilities (in the loss, and in the exported ONNX graph).
 - EdgeConv (Wang et al., DGCNN): edge features [x_j - x_i, x_i] over the k = 10 nearest
   neighbours (the point itself included), a shared 1x1 convolution, max over neighbours.
   Table 1 lists the edge-feature width as the stage's input width; with [x_j - x_i, x_i]
