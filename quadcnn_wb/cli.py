@@ -15,6 +15,7 @@ from .core.background import BackgroundMeshError, background_mesh
 from .core.domain import DomainError, load_domain
 from .core.framefield import FieldError
 from .core.partition import PartitionError
+from .infer.predictor import ModelError
 
 
 class UsageError(Exception):
@@ -178,10 +179,17 @@ def _run_mesh(args) -> None:
 
     out = _check_output(args.output, FORMATS)
     png = _check_output(args.png, {".png"})
-    if args.method == "cnn" or args.model:
-        raise UsageError("the cnn method needs trained models, which this version does not "
-                         "ship yet; use --method numerical (or auto)")
-    result = mesh_domain(load_domain(args.input), size=args.size, nodes=args.nodes)
+    source = None
+    if args.model:
+        from .infer.cnn import cnn_streamlines
+
+        source = cnn_streamlines(args.model)
+    elif args.method == "cnn":
+        raise UsageError("the cnn method needs a model: --model MODEL.onnx (from 'quadcnn "
+                         "train'); no trained models ship with this version yet")
+    method = "numerical" if args.method == "numerical" else args.method
+    result = mesh_domain(load_domain(args.input), size=args.size, nodes=args.nodes,
+                         method=method, learned_streamlines=source)
     if out:
         export(result, out)
     if png:
@@ -267,8 +275,8 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         args.run(args)
-    except (DomainError, BackgroundMeshError, FieldError, PartitionError, UsageError,
-            OSError) as exc:
+    except (DomainError, BackgroundMeshError, FieldError, PartitionError, ModelError,
+            UsageError, OSError) as exc:
         message = " ".join(str(exc).split())
         print(f"error: {message}", file=sys.stderr)
         return 2

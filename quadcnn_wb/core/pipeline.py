@@ -7,18 +7,22 @@ them without recomputing.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .background import background_mesh
 from .cuts import connecting_cuts
 from .domain import Domain
-from .partition import Partition, build_partition
+from .framefield import compute_frame_field
+from .partition import Partition, PartitionError, build_partition
 from .quadmesh import QuadMesh, build_quad_mesh
 from .quality import mesh_quality
 from .quantize import quantize
-from .reference import Reference, numerical_reference
+from .reference import Reference
+from .tracing import trace_streamlines
 
 DEFAULT_SIZE_DIVISOR = 40  # default element size: the domain diagonal / this
 
@@ -62,19 +66,48 @@ def default_size(domain: Domain) -> float:
 
 
 def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
-                method: str = "numerical", smoothing: bool = True) -> MeshResult:
-    """Run the numerical path end to end."""
-    if method not in ("numerical", "auto"):
-        raise ValueError(f"method {method!r} is not available")
+                method: str = "numerical", smoothing: bool = True,
+                learned_streamlines=None) -> MeshResult:
+    """Domain to quad mesh.
+
+    method "numerical" traces the streamlines; "cnn" takes them from
+    ``learned_streamlines(domain, background, field) -> (lines, problems)`` (see
+    infer.cnn; core itself never imports onnxruntime), and if those do not cut the domain
+    into four-sided blocks, every streamline is traced numerically instead, so every valid
+    input still gets a valid mesh.  "auto" is "cnn" when a learned source is given.
+    """
+    if method not in ("numerical", "auto", "cnn"):
+        raise ValueError(f"unknown method {method!r} (auto, cnn or numerical)")
+    if method == "auto":
+        method = "cnn" if learned_streamlines is not None else "numerical"
+    if method == "cnn" and learned_streamlines is None:
+        raise ValueError("the cnn method needs a model")
     size = default_size(domain) if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
-    reference = numerical_reference(domain, nodes=nodes, labels=False)
-    timings = {k: v for k, v in reference.timings.items() if k != "total"}
+    timings = {}
     clock = time.perf_counter()
-    cuts = connecting_cuts(domain, reference.mesh, reference.field, reference.streamlines)
-    partition = build_partition(domain, reference.streamlines, reference.mesh.element_size,
-                                cuts)
+    background = background_mesh(domain, nodes=nodes)
+    timings["background"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    field = compute_frame_field(background)
+    timings["field"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    if method == "cnn":
+        lines, _ = learned_streamlines(domain, background, field)
+        timings["reconstruction"] = time.perf_counter() - clock
+    else:
+        lines = trace_streamlines(domain, background, field)
+        timings["tracing"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    try:
+        cuts, partition = _partition(domain, background, field, lines)
+    except PartitionError:
+        if method != "cnn":
+            raise
+        lines = tuple(dataclasses.replace(line, fallback=True)
+                      for line in trace_streamlines(domain, background, field))
+        cuts, partition = _partition(domain, background, field, lines)
     timings["partition"] = time.perf_counter() - clock
     clock = time.perf_counter()
     counts = quantize(partition, size)
@@ -86,6 +119,13 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     quality = mesh_quality(domain, mesh)
     timings["quality"] = time.perf_counter() - clock
     timings["total"] = sum(timings.values())
+    reference = Reference(domain, background, field, tuple(lines), None, dict(timings))
+    fallback = [k for k, line in enumerate(lines) if line.fallback] if method == "cnn" else []
     return MeshResult(domain=domain, reference=reference, cuts=cuts, partition=partition,
-                      counts=counts, mesh=mesh, quality=quality, size=size,
-                      method="numerical", timings=timings)
+                      counts=counts, mesh=mesh, quality=quality, size=size, method=method,
+                      fallback=fallback, timings=timings)
+
+
+def _partition(domain, background, field, lines):
+    cuts = connecting_cuts(domain, background, field, lines)
+    return cuts, build_partition(domain, lines, background.element_size, cuts)

@@ -95,12 +95,18 @@ class QuadMeshProxy:
             face, plane, placement = source_shape_and_placement(source)
             label = source[0].Label if isinstance(source, tuple) else source.Label
             domain = face_to_domain(face, plane, label)
-            if obj.Method == "cnn":
-                raise ValueError("the cnn method needs trained models, which this version "
-                                 "does not ship yet; use auto or numerical")
+            learned = None
+            if obj.Model and obj.Method != "numerical":
+                from ..infer.cnn import cnn_streamlines
+
+                learned = cnn_streamlines(obj.Model)
+            elif obj.Method == "cnn":
+                raise ValueError("the cnn method needs a model: set the Model property to a "
+                                 "trained .onnx")
             size = float(obj.ElementSize) or None
             result = mesh_domain(domain, size=size, nodes=int(obj.TargetNodes),
-                                 smoothing=bool(obj.Smoothing))
+                                 method=obj.Method, smoothing=bool(obj.Smoothing),
+                                 learned_streamlines=learned)
         except (DomainError, ValueError, RuntimeError) as exc:
             message = " ".join(str(exc).split())
             obj.Status = f"error: {message}"
