@@ -196,6 +196,8 @@ def _run_mesh(args) -> None:
         from .viz.mesh_plot import plot_mesh
 
         plot_mesh(result, png)
+    if not result.structured:
+        print(f"warning: {result.problem}", file=sys.stderr)
     q = result.quality
     print(f"{q['quads']} quads in {q['blocks']} blocks, min scaled Jacobian "
           f"{q['min_scaled_jacobian']:.3f} (mean {q['mean_scaled_jacobian']:.3f}), "

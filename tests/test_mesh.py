@@ -17,7 +17,7 @@ from quadcnn_wb.core.domain import load_domain
 from quadcnn_wb.core.pipeline import mesh_domain
 from quadcnn_wb.core.quantize import side_counts
 
-MESHABLE_OWN = [name for name in OWN_SHAPES if name != "hexagon"]
+MESHABLE_OWN = [name for name in OWN_SHAPES if name != "hexagon"]  # see the last test
 
 
 @functools.cache
@@ -134,3 +134,15 @@ def test_a_partition_that_is_not_four_sided_is_refused():
     incomplete = [line for line in lines if line.end.kind != "singularity"][1:]
     with pytest.raises(PartitionError, match="corners instead of 4|turns back"):
         build_partition(result.domain, incomplete, result.reference.mesh.element_size)
+
+
+def test_without_a_block_structure_gmsh_quads_stand_in():
+    # A regular hexagon's field splits a valence-6 point into two valence-5 points a hair
+    # apart; no four-sided partition comes out, yet a valid all-quad mesh must.
+    result = meshed("hexagon")
+    assert not result.structured and "no block structure" in result.problem
+    check_quad_mesh(result.mesh.nodes, result.mesh.quads, result.domain.area,
+                    on_boundary_of(result.domain))
+    data = result.to_json()
+    assert data["structured"] is False and data["problem"] == result.problem
+    assert meshed("plate_hole").to_json()["structured"] is True

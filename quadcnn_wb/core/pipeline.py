@@ -17,6 +17,7 @@ from .background import background_mesh
 from .cuts import connecting_cuts
 from .domain import Domain
 from .framefield import compute_frame_field
+from .gmsh_quads import gmsh_quad_mesh
 from .partition import Partition, PartitionError, build_partition
 from .quadmesh import QuadMesh, build_quad_mesh
 from .quality import mesh_quality
@@ -39,6 +40,8 @@ class MeshResult:
     size: float
     method: str = "numerical"
     fallback: list = field(default_factory=list)
+    structured: bool = True  # False: the partition failed and gmsh's quad mesh stands in
+    problem: str = ""  # why the mesh is not block-structured
     timings: dict = field(default_factory=dict)
 
     @property
@@ -56,6 +59,8 @@ class MeshResult:
             "streamlines": [line.points.tolist() for line in self.streamlines],
             "method": self.method,
             "fallback": list(self.fallback),
+            "structured": self.structured,
+            **({"problem": self.problem} if self.problem else {}),
             "quality": dict(self.quality),
             "timings": dict(self.timings),
         }
@@ -100,21 +105,30 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
         lines = trace_streamlines(domain, background, field)
         timings["tracing"] = time.perf_counter() - clock
     clock = time.perf_counter()
+    problem = ""
     try:
-        cuts, partition = _partition(domain, background, field, lines)
-    except PartitionError:
-        if method != "cnn":
-            raise
-        lines = tuple(dataclasses.replace(line, fallback=True)
-                      for line in trace_streamlines(domain, background, field))
-        cuts, partition = _partition(domain, background, field, lines)
-    timings["partition"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    counts = quantize(partition, size)
-    timings["quantization"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
-    timings["quad_mesh"] = time.perf_counter() - clock
+        try:
+            cuts, partition = _partition(domain, background, field, lines)
+        except PartitionError:
+            if method != "cnn":
+                raise
+            lines = tuple(dataclasses.replace(line, fallback=True)
+                          for line in trace_streamlines(domain, background, field))
+            cuts, partition = _partition(domain, background, field, lines)
+        timings["partition"] = time.perf_counter() - clock
+        clock = time.perf_counter()
+        counts = quantize(partition, size)
+        timings["quantization"] = time.perf_counter() - clock
+        clock = time.perf_counter()
+        mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
+        timings["quad_mesh"] = time.perf_counter() - clock
+    except PartitionError as exc:
+        # Never leave a valid input without a mesh: gmsh's unstructured quads stand in.
+        problem = f"no block structure ({exc}); unstructured all-quad mesh from gmsh"
+        cuts, partition, counts = [], Partition(np.zeros((0, 2)), [], [], []), np.zeros(0, int)
+        clock = time.perf_counter()
+        mesh = gmsh_quad_mesh(domain, size)
+        timings["quad_mesh"] = time.perf_counter() - clock
     clock = time.perf_counter()
     quality = mesh_quality(domain, mesh)
     timings["quality"] = time.perf_counter() - clock
@@ -123,7 +137,8 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     fallback = [k for k, line in enumerate(lines) if line.fallback] if method == "cnn" else []
     return MeshResult(domain=domain, reference=reference, cuts=cuts, partition=partition,
                       counts=counts, mesh=mesh, quality=quality, size=size, method=method,
-                      fallback=fallback, timings=timings)
+                      fallback=fallback, timings=timings, structured=not problem,
+                      problem=problem)
 
 
 def _partition(domain, background, field, lines):

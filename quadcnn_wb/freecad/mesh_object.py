@@ -125,7 +125,9 @@ class QuadMeshProxy:
         obj.MethodUsed = result.method
         obj.Fallbacks = list(result.fallback)
         obj.Timings = json.dumps({k: round(v, 4) for k, v in result.timings.items()})
-        obj.Status = "ok"
+        obj.Status = "ok" if result.structured else f"ok, but {result.problem}"
+        if not result.structured:
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: {result.problem}\n")
         FreeCAD.Console.PrintLog(f"{obj.Label}: {q['quads']} quads in "
                                  f"{time.perf_counter() - started:.2f} s\n")
 
