@@ -146,3 +146,27 @@ def test_without_a_block_structure_gmsh_quads_stand_in():
     data = result.to_json()
     assert data["structured"] is False and data["problem"] == result.problem
     assert meshed("plate_hole").to_json()["structured"] is True
+
+
+def test_three_cornered_faces_are_split_into_blocks():
+    # A 22° corner rounds to zero quarter turns: the face there has three corners, which
+    # midpoint subdivision turns into three blocks around one extra valence-3 vertex.
+    from shapes import polygon
+
+    domain = domain_from_json({"loops": [polygon([[0, 0], [3, 0], [0, 1.2]])]})
+    result = mesh_domain(domain)
+    assert result.structured and result.quality["blocks"] == 3
+    check_quad_mesh(result.mesh.nodes, result.mesh.quads, domain.area, on_boundary_of(domain))
+    assert result.quality["irregular_vertices"] == 1
+    assert result.quality["min_scaled_jacobian"] > 0.3
+
+
+def test_overlapping_blocks_are_detected():
+    from quadcnn_wb.core.pipeline import tiles_exactly
+
+    nodes = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1], [0.5, 0], [0.5, 1]],
+                     dtype=float)
+    side_by_side = np.array([[0, 1, 2, 3], [1, 4, 5, 2]])
+    folded = np.array([[0, 1, 2, 3], [6, 4, 5, 7]])  # second quad lies half on the first
+    assert tiles_exactly(nodes, side_by_side)
+    assert not tiles_exactly(nodes, folded)

@@ -135,9 +135,11 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
         edges.extend(_split_line(pts, splits[k], k))
     for li in range(len(domain.loops)):
         edges.extend(_boundary_edges(domain, li, sorted(boundary_splits[li]), verts))
-    vertices = np.array(verts.xy)
-    blocks = _faces_to_blocks(vertices, edges, element_size)
-    return Partition(vertices=vertices, edges=edges, blocks=blocks, cuts=list(cuts))
+    faces = _faces_to_blocks(np.array(verts.xy), edges, element_size)
+    from .subdivide import split_odd_faces
+
+    vertices, blocks = split_odd_faces(verts.xy, edges, faces, domain, element_size)
+    return Partition(vertices=np.array(vertices), edges=edges, blocks=blocks, cuts=list(cuts))
 
 
 def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
@@ -339,15 +341,16 @@ def _block_of(cycle, half, edges, vertices, h, head):
         raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
                              f"{_fmt(vertices[head(cycle[k])])}: not a four-sided block")
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
-    if len(corner_at) != 4:
+    if len(corner_at) not in (3, 4, 5):
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
         raise PartitionError(f"a block near {_fmt(centre)} has {len(corner_at)} corners "
                              f"instead of 4")
+    n_sides = len(corner_at)
     sides = []
     corners = []
-    for s in range(4):
+    for s in range(n_sides):
         first = (corner_at[s] + 1) % len(cycle)
-        last = corner_at[(s + 1) % 4]
+        last = corner_at[(s + 1) % n_sides]
         idx = []
         k = first
         while True:
@@ -355,9 +358,9 @@ def _block_of(cycle, half, edges, vertices, h, head):
             if k == last:
                 break
             k = (k + 1) % len(cycle)
-        sides.append(tuple(half[cycle[i]] for i in idx))
+        sides.append([half[cycle[i]] for i in idx])
         corners.append(head(cycle[corner_at[s]]))
-    return Block(corners=tuple(corners), sides=tuple(sides))
+    return corners, sides
 
 
 def _fmt(p) -> str:

@@ -19,13 +19,14 @@ from .domain import Domain
 from .framefield import compute_frame_field
 from .gmsh_quads import gmsh_quad_mesh
 from .partition import Partition, PartitionError, build_partition
-from .quadmesh import QuadMesh, build_quad_mesh
+from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality
 from .quantize import quantize
 from .reference import Reference
 from .tracing import trace_streamlines
 
 DEFAULT_SIZE_DIVISOR = 40  # default element size: the domain diagonal / this
+MIN_VALID_JACOBIAN = 0.05  # a block-structured mesh worse than this is not handed out
 
 
 @dataclass
@@ -122,6 +123,12 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
         clock = time.perf_counter()
         mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
         timings["quad_mesh"] = time.perf_counter() - clock
+        worst = scaled_jacobians(mesh.nodes, mesh.quads).min() if len(mesh.quads) else 0.0
+        if worst <= MIN_VALID_JACOBIAN:
+            raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
+                                 f"{worst:.3f})")
+        if not tiles_exactly(mesh.nodes, mesh.quads):
+            raise PartitionError("the blocks overlap (their quads fold over each other)")
     except PartitionError as exc:
         # Never leave a valid input without a mesh: gmsh's unstructured quads stand in.
         problem = f"no block structure ({exc}); unstructured all-quad mesh from gmsh"
@@ -139,6 +146,23 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
                       counts=counts, mesh=mesh, quality=quality, size=size, method=method,
                       fallback=fallback, timings=timings, structured=not problem,
                       problem=problem)
+
+
+def tiles_exactly(nodes, quads) -> bool:
+    """No overlaps: the quads' areas add up to the area their free edges enclose.
+
+    Positive corners alone do not exclude a block folded over its neighbour; this does.
+    """
+    p = nodes[quads]
+    area = 0.5 * np.sum(p[..., 0] * np.roll(p[..., 1], -1, axis=1)
+                        - np.roll(p[..., 0], -1, axis=1) * p[..., 1])
+    directed = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    key = np.sort(directed, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    free = directed[counts[inverse.ravel()] == 1]
+    a, b = nodes[free[:, 0]], nodes[free[:, 1]]
+    enclosed = 0.5 * np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1])
+    return bool(abs(area - enclosed) <= 1e-9 * max(abs(enclosed), 1e-300))
 
 
 def _partition(domain, background, field, lines):

@@ -1,0 +1,154 @@
+"""Three- and five-cornered faces of a partition, split into quadrilateral blocks.
+
+Near an acute corner (under 45°, a quarter-turn count of 0) or where singular points
+nearly coincide, a face of the streamline arrangement can come out with 3 or 5 corners.
+Midpoint subdivision turns a k-cornered face into k blocks meeting at its centre: every
+side is cut at its middle (the neighbouring block just gets a T-junction there) and joined
+to the centre.  The centre becomes one extra irregular vertex (valence k), which is the
+price of a block-structured mesh there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .partition import Block, BoundaryPiece, Edge, PartitionError, _fmt
+
+MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
+
+
+def split_odd_faces(vertices: list, edges: list, faces: list, domain, h):
+    """(vertex list, blocks): four-cornered faces as they are, others subdivided."""
+    vertices = list(vertices)
+    odd = [f for f in faces if len(f[0]) != 4]
+    blocks = []
+    for corners, sides in odd:
+        mids = []
+        for j in range(len(sides)):
+            mids.append(_split_side(vertices, edges, faces, sides, j, domain))
+        centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
+        polygon = np.array([vertices[c] for c in corners])
+        if not _inside_polygon(polygon, centre):
+            raise PartitionError(f"a {len(corners)}-cornered block near {_fmt(centre)} is "
+                                 "too concave to split into quadrilaterals")
+        c_id = len(vertices)
+        vertices.append(centre)
+        spokes = []
+        for m in mids:
+            pts = np.linspace(centre, vertices[m], 8)
+            spokes.append(len(edges))
+            edges.append(Edge(points=pts, a=c_id, b=m))
+        k = len(corners)
+        for j in range(k):
+            first_half = sides[j][: _mid_index(sides[j], edges, mids[j]) + 1]
+            prev = (j - 1) % k
+            second_half = sides[prev][_mid_index(sides[prev], edges, mids[prev]) + 1:]
+            blocks.append(Block(corners=(corners[j], mids[j], c_id, mids[prev]),
+                                sides=(tuple(first_half), ((spokes[j], False),),
+                                       ((spokes[prev], True),), tuple(second_half))))
+    for corners, sides in faces:
+        if len(corners) == 4:
+            blocks.append(Block(corners=tuple(corners), sides=tuple(tuple(s) for s in sides)))
+    return vertices, blocks
+
+
+def _head(edges, half):
+    e, forward = half
+    return edges[e].b if forward else edges[e].a
+
+
+def _mid_index(side, edges, vertex):
+    """Index in side of the half-edge that ends at vertex."""
+    for i, half in enumerate(side):
+        if _head(edges, half) == vertex:
+            return i
+    raise PartitionError("lost a side's midpoint while splitting a block")
+
+
+def _side_points(side, edges):
+    pts = []
+    for e, forward in side:
+        p = edges[e].points if forward else edges[e].points[::-1]
+        pts.extend(p if not pts else p[1:])
+    return np.array(pts)
+
+
+def _split_side(vertices, edges, faces, sides, j, domain) -> int:
+    """Vertex id in the middle of side j (an existing one, or a new one from a split)."""
+    side = sides[j]
+    lengths = np.array([edges[e].length for e, _ in side])
+    total = float(lengths.sum())
+    ends = np.cumsum(lengths)
+    inner = ends[:-1]
+    if len(inner):
+        k = int(np.argmin(np.abs(inner - total / 2)))
+        if abs(inner[k] - total / 2) <= MIDPOINT_SNAP * total:
+            return _head(edges, side[k])
+    # Split the half-edge holding the middle.
+    k = int(np.searchsorted(ends, total / 2))
+    e, forward = side[k]
+    along = total / 2 - (ends[k] - lengths[k])
+    s = along if forward else lengths[k] - along  # arc length from the edge's start
+    new_vertex, tail = _split_edge(vertices, edges, e, s, domain)
+    for _, other_sides in faces:
+        for other in other_sides:
+            _replace_half(other, e, tail)
+    return new_vertex
+
+
+def _replace_half(side, e, tail):
+    i = 0
+    while i < len(side):
+        edge, forward = side[i]
+        if edge == e:
+            side[i:i + 1] = [(e, True), (tail, True)] if forward else [(tail, False), (e, False)]
+            i += 2
+        else:
+            i += 1
+
+
+def _split_edge(vertices, edges, e, s, domain):
+    """Cut edge e at arc length s; e keeps the first part, a new edge the rest."""
+    edge = edges[e]
+    pts = edge.points
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+    if edge.is_boundary:
+        first, second, point = _split_pieces(edge.pieces, s, domain)
+    else:
+        first = second = ()
+        k = int(np.clip(np.searchsorted(cum, s) - 1, 0, len(pts) - 2))
+        f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
+        point = pts[k] + f * (pts[k + 1] - pts[k])
+    v = len(vertices)
+    vertices.append(np.asarray(point, dtype=float))
+    before = pts[cum < s]
+    after = pts[cum > s]
+    edges[e] = Edge(points=np.vstack([before, point]), a=edge.a, b=v, pieces=first,
+                    streamline=edge.streamline)
+    edges.append(Edge(points=np.vstack([point, after]), a=v, b=edge.b, pieces=second,
+                      streamline=edge.streamline))
+    return v, len(edges) - 1
+
+
+def _split_pieces(pieces, s, domain):
+    """Split exact boundary stretches at arc length s: (first, second, point)."""
+    remaining = s
+    for i, p in enumerate(pieces):
+        curve = domain.loops[p.loop][p.segment]
+        length = curve.length * abs(p.t1 - p.t0)
+        if remaining <= length or i == len(pieces) - 1:
+            t = p.t0 + (p.t1 - p.t0) * min(max(remaining / length, 0.0), 1.0)
+            first = tuple(pieces[:i]) + (BoundaryPiece(p.loop, p.segment, p.t0, t),)
+            second = (BoundaryPiece(p.loop, p.segment, t, p.t1),) + tuple(pieces[i + 1:])
+            return first, second, curve.point(t)
+        remaining -= length
+    raise PartitionError("could not split a boundary edge")
+
+
+def _inside_polygon(polygon, p) -> bool:
+    x, y = p
+    inside = False
+    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
