@@ -153,6 +153,8 @@ def test_three_cornered_faces_are_split_into_blocks():
     # midpoint subdivision turns into three blocks around one extra valence-3 vertex.
     from shapes import polygon
 
+    from quadcnn_wb.core.domain import domain_from_json
+
     domain = domain_from_json({"loops": [polygon([[0, 0], [3, 0], [0, 1.2]])]})
     result = mesh_domain(domain)
     assert result.structured and result.quality["blocks"] == 3
