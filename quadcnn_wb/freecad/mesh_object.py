@@ -26,6 +26,8 @@ PROPERTIES = (
     ("App::PropertyLength", "ElementSize", "QuadCNN",
      "Target quad size (0: the source's diagonal / 40)"),
     ("App::PropertyBool", "Smoothing", "QuadCNN", "Smooth the mesh after the block maps"),
+    ("App::PropertyLink", "Part", "QuadCNN",
+     "The source's object, for FEM: CalculiX maps constraints through this link"),
     ("App::PropertyLink", "StreamlineWires", "QuadCNN", "Companion: streamlines as wires"),
     ("App::PropertyLink", "BlockFaces", "QuadCNN", "Companion: the blocks as faces"),
     ("App::PropertyInteger", "Blocks", "Results", "Number of blocks"),
@@ -149,8 +151,10 @@ def make_quad_mesh(doc, source, name: str = "QuadMesh", **properties):
     QuadMeshProxy(obj)
     if isinstance(source, (tuple, list)):
         obj.Source = (source[0], [source[1]])
+        obj.Part = source[0]
     else:
         obj.Source = (source, [])
+        obj.Part = source
     for key, value in properties.items():
         setattr(obj, key, value)
     obj.StreamlineWires = doc.addObject("Part::Feature", f"{obj.Name}_Streamlines")

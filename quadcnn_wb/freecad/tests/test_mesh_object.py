@@ -194,3 +194,20 @@ class TestSketchInBody(unittest.TestCase):
             self.assertEqual(zs, {50.0})
         finally:
             FreeCAD.closeDocument(doc.Name)
+
+
+class TestFemAnalysis(unittest.TestCase):
+    def test_bundled_plate_analysis_matches_the_concentration_factor(self):
+        from quadcnn_wb.freecad.environment import resource_path
+        from quadcnn_wb.freecad.fem_example import solve
+
+        doc = FreeCAD.openDocument(resource_path("examples", "plate_tension.FCStd"))
+        try:
+            mesh = doc.getObject("QuadMesh")
+            mesh.touch()
+            doc.recompute()
+            self.assertTrue(mesh.isValid(), mesh.Status)
+            result = solve(doc)
+            self.assertLess(abs(result["error"]), 0.05, result)
+        finally:
+            FreeCAD.closeDocument(doc.Name)
