@@ -211,3 +211,28 @@ class TestFemAnalysis(unittest.TestCase):
             self.assertLess(abs(result["error"]), 0.05, result)
         finally:
             FreeCAD.closeDocument(doc.Name)
+
+
+class TestUndo(unittest.TestCase):
+    def test_undoing_a_breaking_edit_restores_a_valid_mesh(self):
+        doc = FreeCAD.newDocument("QuadCNNUndo")
+        try:
+            doc.UndoMode = 1
+            sk, _, radius = plate_sketch(doc, FreeCAD.Placement())
+            mesh = make_quad_mesh(doc, sk, ElementSize=2.0)
+            doc.recompute()
+            good = mesh.Quads
+            doc.openTransaction("break the hole")
+            sk.setDatum(radius, FreeCAD.Units.Quantity("15 mm"))
+            doc.commitTransaction()
+            doc.recompute()
+            self.assertFalse(mesh.isValid())
+            doc.undo()
+            doc.recompute()
+            self.assertEqual(sk.getDatum(radius).Value, 5.0)
+            mesh.touch()
+            doc.recompute()
+            self.assertTrue(mesh.isValid(), mesh.Status)
+            self.assertEqual((mesh.Quads, mesh.Status), (good, "ok"))
+        finally:
+            FreeCAD.closeDocument(doc.Name)
