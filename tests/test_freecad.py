@@ -25,31 +25,63 @@ def test_freecadcmd_runs_the_registered_test_module(tmp_path):
 
 
 GUI_CHECK = """
-import json, os
-import FreeCADGui
+import json, os, traceback
+import FreeCAD, FreeCADGui
 result = {}
 try:
     result["listed"] = "QuadCNNWorkbench" in FreeCADGui.listWorkbenches()
     FreeCADGui.activateWorkbench("QuadCNNWorkbench")
     result["active"] = FreeCADGui.activeWorkbench().name()
     result["menu_text"] = FreeCADGui.activeWorkbench().MenuText
-except Exception as exc:
-    result["error"] = repr(exc)
-with open(%r, "w") as handle:
+    result["commands"] = sorted(c for c in FreeCADGui.listCommands()
+                                if c.startswith("QuadCNN_"))
+    doc = FreeCAD.openDocument(%(design)r)
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(doc.getObject("Plate"))
+    FreeCADGui.runCommand("QuadCNN_CreateMesh")
+    mesh = [o for o in doc.Objects if o.TypeId == "Fem::FemMeshObjectPython"][0]
+    result["valid"] = mesh.isValid()
+    result["quads"] = mesh.Quads
+    result["mode"] = mesh.ViewObject.DisplayMode
+    result["modes"] = mesh.ViewObject.listDisplayModes()
+    result["status"] = mesh.Status
+    FreeCADGui.Selection.clearSelection()
+    view = FreeCADGui.ActiveDocument.ActiveView
+    view.viewFront()
+    FreeCADGui.SendMsgToActiveView("ViewFit")
+    view.saveImage(%(image)r, 800, 600, "White")
+except Exception:
+    result["error"] = traceback.format_exc()
+with open(%(report)r, "w") as handle:
     json.dump(result, handle)
 os._exit(0)
 """
 
 
-def test_workbench_activates_in_the_gui_under_xvfb(tmp_path):
-    report = tmp_path / "gui.json"
+def test_workbench_gui_creates_a_mesh_under_xvfb(tmp_path):
+    import matplotlib.image
+
+    report, image = tmp_path / "gui.json", tmp_path / "view.png"
+    design = tmp_path / "design.FCStd"
+    shutil.copyfile(REPO / "resources" / "examples" / "plate_design.FCStd", design)
     script = tmp_path / "gui_check.py"
-    script.write_text(GUI_CHECK % str(report))
-    result = subprocess.run(["xvfb-run", "-a", "freecad", str(script)], capture_output=True,
-                            text=True, cwd=tmp_path, env=FREECAD_ENV, timeout=300)
+    script.write_text(GUI_CHECK % {"design": str(design), "image": str(image),
+                                   "report": str(report)})
+    result = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
+                             str(script)], capture_output=True, text=True, cwd=tmp_path,
+                            env=FREECAD_ENV, timeout=300)
     assert report.is_file(), (result.stdout + result.stderr)[-3000:]
     data = json.loads(report.read_text())
-    assert data == {"listed": True, "active": "QuadCNNWorkbench", "menu_text": "QuadCNN"}, data
+    assert "error" not in data, data.get("error")
+    assert data["listed"] and data["active"] == "QuadCNNWorkbench"
+    assert data["menu_text"] == "QuadCNN"
+    assert data["commands"] == ["QuadCNN_CreateMesh", "QuadCNN_ExportMesh",
+                                "QuadCNN_RegenerateAll"]
+    assert data["valid"] and data["quads"] > 100
+    assert data["mode"] == "Faces & Wireframe"
+    pixels = matplotlib.image.imread(image)[..., :3]
+    assert pixels.std() > 0.05, "the 3D view screenshot is blank"
+    assert (pixels.mean(axis=2) < 0.6).mean() > 0.01  # mesh lines drawn on the white view
 
 
 def test_headless_demo_edits_regenerates_saves_and_exports(tmp_path):

@@ -69,6 +69,10 @@ class QuadMeshProxy:
     def onDocumentRestored(self, obj):
         self.last_result = None
         add_properties(obj)
+        if FreeCAD.GuiUp and obj.ViewObject is not None and obj.ViewObject.Proxy is None:
+            from .view_provider import ViewProviderQuadMesh
+
+            ViewProviderQuadMesh(obj.ViewObject)
 
     # FreeCAD 0.20 pickles proxies with __getstate__/__setstate__, 0.21+ with dumps/loads.
     def __getstate__(self):
@@ -159,4 +163,11 @@ def make_quad_mesh(doc, source, name: str = "QuadMesh", **properties):
         setattr(obj, key, value)
     obj.StreamlineWires = doc.addObject("Part::Feature", f"{obj.Name}_Streamlines")
     obj.BlockFaces = doc.addObject("Part::Feature", f"{obj.Name}_Blocks")
+    if FreeCAD.GuiUp:  # the mesh itself is what the user wants to see; blocks on demand
+        from .view_provider import ViewProviderQuadMesh
+
+        ViewProviderQuadMesh(obj.ViewObject)
+        obj.BlockFaces.ViewObject.Visibility = False
+        obj.StreamlineWires.ViewObject.LineColor = (0.1, 0.62, 0.23)
+        obj.StreamlineWires.ViewObject.LineWidth = 3.0
     return obj

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import FreeCAD
 
-COMMANDS: list[str] = []  # QuadCNN_* commands register here as they are added
-
 
 def initialize(workbench) -> None:
-    """Build the QuadCNN toolbar and menu from the registered commands."""
-    if COMMANDS:
-        workbench.appendToolbar("QuadCNN", COMMANDS)
-        workbench.appendMenu("QuadCNN", COMMANDS)
+    """Register the QuadCNN_* commands and build the QuadCNN toolbar and menu."""
+    from . import commands
+
+    names = commands.register()
+    workbench.appendToolbar("QuadCNN", names)
+    workbench.appendMenu("QuadCNN", names)
     FreeCAD.Console.PrintLog("QuadCNN workbench initialised\n")
