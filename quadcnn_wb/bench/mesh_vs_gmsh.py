@@ -17,6 +17,7 @@ import gmsh
 import numpy as np
 
 from ..core.background import _build_geometry
+from ..core.gmsh_quads import read_quads
 from ..core.gmsh_session import gmsh_session
 from ..core.pipeline import DEFAULT_SIZE_DIVISOR, mesh_domain
 from ..core.quadmesh import scaled_jacobians
@@ -35,20 +36,12 @@ def gmsh_quasi_structured(domain, size: float):
         start = time.perf_counter()
         gmsh.model.mesh.generate(2)
         seconds = time.perf_counter() - start
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        index = {int(t): k for k, t in enumerate(tags)}
-        nodes = xyz.reshape(-1, 3)[:, :2]
-        quads = []
-        for _, tag in gmsh.model.getEntities(2):
-            types, _, node_tags = gmsh.model.mesh.getElements(2, tag)
-            for etype, nt in zip(types, node_tags):
-                if etype == 3:
-                    quads.append(np.array([index[int(t)] for t in nt]).reshape(-1, 4))
+        nodes, quads, index = read_quads()
         boundary = np.zeros(len(nodes), dtype=bool)
         for _, tag in gmsh.model.getEntities(1):
             btags, _, _ = gmsh.model.mesh.getNodes(1, tag, includeBoundary=True)
             boundary[[index[int(t)] for t in btags]] = True
-    return nodes, np.concatenate(quads), boundary, seconds
+    return nodes, quads, boundary, seconds
 
 
 def score(domain, nodes, quads, boundary):

@@ -27,15 +27,8 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
                             ("Mesh.MeshSizeFromPoints", 0), ("Mesh.MeshSizeFromCurvature", 0)):
             session.set(name, value)
         gmsh.model.mesh.generate(2)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        index = {int(t): k for k, t in enumerate(tags)}
-        nodes = xyz.reshape(-1, 3)[:, :2] * scale + center
-        quads = []
-        for _, tag in gmsh.model.getEntities(2):
-            types, _, node_tags = gmsh.model.mesh.getElements(2, tag)
-            for etype, nt in zip(types, node_tags):
-                if etype == 3:
-                    quads.append(np.array([index[int(t)] for t in nt]).reshape(-1, 4))
+        nodes, quads, index = read_quads()
+        nodes = nodes * scale + center
         boundary = np.zeros(len(nodes), dtype=bool)
         for tag, (li, si) in curve_tags.items():
             btags, _, _ = gmsh.model.mesh.getNodes(1, tag, includeBoundary=True)
@@ -44,7 +37,6 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
             curve = domain.loops[li][si]
             for k in ids:  # exactly on the true curve
                 nodes[k] = curve.point(curve.project(nodes[k]))
-    quads = np.concatenate(quads)
     used = np.unique(quads)
     remap = np.full(len(nodes), -1)
     remap[used] = np.arange(len(used))
@@ -53,3 +45,17 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
     nodes = smooth(nodes, quads, boundary)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=np.zeros(len(quads), dtype=np.int64),
                     boundary=boundary, edge_nodes=())
+
+
+def read_quads():
+    """(nodes (N, 2), quads (Q, 4), gmsh tag -> row) of the current gmsh model's mesh."""
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    index = {int(t): k for k, t in enumerate(tags)}
+    quads = []
+    for _, tag in gmsh.model.getEntities(2):
+        types, _, node_tags = gmsh.model.mesh.getElements(2, tag)
+        for etype, nt in zip(types, node_tags):
+            if etype == 3:  # 4-node quadrangle
+                quads.append(np.array([index[int(t)] for t in nt]).reshape(-1, 4))
+    quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
+    return xyz.reshape(-1, 3)[:, :2].copy(), quads, index

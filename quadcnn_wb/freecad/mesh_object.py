@@ -14,6 +14,8 @@ import time
 
 import FreeCAD
 
+from .view_provider import Stateless
+
 PROPERTIES = (
     # (type, name, group, tooltip)
     ("App::PropertyLinkSub", "Source", "QuadCNN", "Sketch or planar face to mesh"),
@@ -58,7 +60,7 @@ def add_properties(obj) -> None:
             obj.setEditorMode(name, 1)
 
 
-class QuadMeshProxy:
+class QuadMeshProxy(Stateless):
     Type = "QuadCNN::QuadMesh"
 
     def __init__(self, obj):
@@ -73,19 +75,6 @@ class QuadMeshProxy:
             from .view_provider import ViewProviderQuadMesh
 
             ViewProviderQuadMesh(obj.ViewObject)
-
-    # FreeCAD 0.20 pickles proxies with __getstate__/__setstate__, 0.21+ with dumps/loads.
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
 
     def execute(self, obj):
         from ..core.domain import DomainError

@@ -9,7 +9,24 @@ from __future__ import annotations
 from .environment import resource_path
 
 
-class ViewProviderQuadMesh:
+class Stateless:
+    """Proxies keep nothing worth saving: FreeCAD 0.20 pickles with __getstate__ and
+    __setstate__, 0.21+ with dumps/loads; all of them say so."""
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+
+class ViewProviderQuadMesh(Stateless):
     def __init__(self, vobj):
         vobj.Proxy = self
 
@@ -26,15 +43,3 @@ class ViewProviderQuadMesh:
         obj = getattr(self, "Object", None)
         return [c for c in (getattr(obj, "StreamlineWires", None),
                             getattr(obj, "BlockFaces", None)) if c is not None]
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
