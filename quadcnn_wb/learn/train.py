@@ -13,7 +13,6 @@ Recipes:
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 import time
 import warnings
@@ -170,7 +169,3 @@ def export_onnx(net: QuadCNN, path) -> None:
 
 def sha256(path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def model_metadata(path) -> dict:
-    return json.loads(Path(path).with_suffix(".json").read_text())
