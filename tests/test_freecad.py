@@ -81,7 +81,7 @@ def test_workbench_gui_creates_a_mesh_under_xvfb(tmp_path):
     assert data["mode"] == "Faces & Wireframe"
     pixels = matplotlib.image.imread(image)[..., :3]
     assert pixels.std() > 0.05, "the 3D view screenshot is blank"
-    assert (pixels.mean(axis=2) < 0.6).mean() > 0.01  # mesh lines drawn on the white view
+    assert (pixels.max(axis=2) < 0.3).mean() > 0.01  # the quad edges (near black) are drawn
 
 
 def test_headless_demo_edits_regenerates_saves_and_exports(tmp_path):

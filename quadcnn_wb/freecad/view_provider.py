@@ -32,6 +32,45 @@ class ViewProviderQuadMesh(Stateless):
 
     def attach(self, vobj):
         self.Object = vobj.Object
+        self._add_edge_lines(vobj)
+
+    def _add_edge_lines(self, vobj):
+        """The FEM view provider shades this face-only mesh but draws no quad edges; a line
+        set above its display modes does."""
+        from pivy import coin
+
+        self.coords = coin.SoCoordinate3()
+        self.lines = coin.SoIndexedLineSet()
+        style = coin.SoDrawStyle()
+        style.lineWidth = 1.0
+        colour = coin.SoBaseColor()
+        colour.rgb = (0.1, 0.1, 0.15)
+        offset = coin.SoPolygonOffset()  # keep the lines in front of the shaded faces
+        sep = coin.SoSeparator()
+        for node in (offset, style, colour, self.coords, self.lines):
+            sep.addChild(node)
+        vobj.RootNode.addChild(sep)
+        self.updateData(vobj.Object, "FemMesh")
+
+    def updateData(self, obj, prop):
+        if prop != "FemMesh" or not hasattr(self, "coords"):
+            return
+        mesh = obj.FemMesh
+        nodes = mesh.Nodes
+        ids = sorted(nodes)
+        row = {n: i for i, n in enumerate(ids)}
+        self.coords.point.setValues(0, len(ids), [tuple(nodes[n]) for n in ids])
+        edges = set()
+        for face in mesh.Faces:
+            corners = mesh.getElementNodes(face)
+            for k in range(len(corners)):
+                a, b = corners[k], corners[(k + 1) % len(corners)]
+                edges.add((min(a, b), max(a, b)))
+        index = []
+        for a, b in sorted(edges):
+            index.extend((row[a], row[b], -1))
+        self.lines.coordIndex.setValues(0, len(index), index)
+        self.lines.coordIndex.setNum(len(index))
 
     def getDefaultDisplayMode(self):
         return "Faces & Wireframe"
