@@ -13,16 +13,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .background import background_mesh
 from .cuts import connecting_cuts
 from .domain import Domain
-from .framefield import compute_frame_field
 from .gmsh_quads import gmsh_quad_mesh
 from .partition import Partition, PartitionError, build_partition
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality
 from .quantize import quantize
-from .reference import Reference
+from .reference import Reference, background_and_field
 from .tracing import trace_streamlines
 
 DEFAULT_SIZE_DIVISOR = 40  # default element size: the domain diagonal / this
@@ -92,12 +90,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
     timings = {}
-    clock = time.perf_counter()
-    background = background_mesh(domain, nodes=nodes)
-    timings["background"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    field = compute_frame_field(background)
-    timings["field"] = time.perf_counter() - clock
+    background, field = background_and_field(domain, nodes, timings)
     clock = time.perf_counter()
     if method == "cnn":
         lines, _ = learned_streamlines(domain, background, field)

@@ -41,9 +41,9 @@ class Reference:
         return out
 
 
-def numerical_reference(domain: Domain, nodes: int = 2048,
-                        mesh: BackgroundMesh | None = None, labels: bool = True) -> Reference:
-    timings = {}
+def background_and_field(domain: Domain, nodes: int, timings: dict,
+                         mesh: BackgroundMesh | None = None):
+    """The stages every path shares: background mesh (unless given) and cross field."""
     clock = time.perf_counter()
     if mesh is None:
         mesh = background_mesh(domain, nodes=nodes)
@@ -51,6 +51,13 @@ def numerical_reference(domain: Domain, nodes: int = 2048,
         clock = time.perf_counter()
     field = compute_frame_field(mesh)
     timings["field"] = time.perf_counter() - clock
+    return mesh, field
+
+
+def numerical_reference(domain: Domain, nodes: int = 2048,
+                        mesh: BackgroundMesh | None = None, labels: bool = True) -> Reference:
+    timings = {}
+    mesh, field = background_and_field(domain, nodes, timings, mesh)
     clock = time.perf_counter()
     streamlines = trace_streamlines(domain, mesh, field)
     timings["tracing"] = time.perf_counter() - clock

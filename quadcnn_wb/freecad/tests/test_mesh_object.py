@@ -9,31 +9,16 @@ import unittest
 
 import FreeCAD
 import Part
-import Sketcher
 
 from quadcnn_wb.freecad import make_quad_mesh
+from quadcnn_wb.freecad.sketches import plate_with_hole
 
 V = FreeCAD.Vector
 
 
 def plate_sketch(doc, placement):
     """A 40 x 20 plate with a radius-5 hole; returns (sketch, width constraint, radius one)."""
-    sk = doc.addObject("Sketcher::SketchObject", "Plate")
-    sk.Placement = placement
-    pts = [V(0, 0, 0), V(40, 0, 0), V(40, 20, 0), V(0, 20, 0)]
-    for a, b in zip(pts, pts[1:] + pts[:1]):
-        sk.addGeometry(Part.LineSegment(a, b))
-    for i in range(4):
-        sk.addConstraint(Sketcher.Constraint("Coincident", i, 2, (i + 1) % 4, 1))
-    for i, kind in enumerate(("Horizontal", "Vertical", "Horizontal", "Vertical")):
-        sk.addConstraint(Sketcher.Constraint(kind, i))
-    sk.addConstraint(Sketcher.Constraint("Coincident", 0, 1, -1, 1))
-    width = sk.addConstraint(Sketcher.Constraint("DistanceX", 0, 1, 0, 2, 40))
-    sk.addConstraint(Sketcher.Constraint("DistanceY", 1, 1, 1, 2, 20))
-    sk.addGeometry(Part.Circle(V(20, 10, 0), V(0, 0, 1), 5))
-    radius = sk.addConstraint(Sketcher.Constraint("Radius", 4, 5))
-    doc.recompute()
-    return sk, width, radius
+    return plate_with_hole(doc, 40.0, 20.0, 5.0, placement)
 
 
 class TestQuadMeshObject(unittest.TestCase):
