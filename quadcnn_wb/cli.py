@@ -97,6 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
     tr.add_argument("--recipe", choices=["paper", "fast"], default="paper")
     tr.add_argument("--threads", type=_positive_count, default=2)
     tr.add_argument("--patience", type=_positive_count, default=6)
+    tr.add_argument("--minutes", type=_positive_float,
+                    help="stop after this wall time, keeping the best epoch so far")
     tr.set_defaults(run=_run_train)
 
     ev = commands.add_parser("evaluate", help="label metrics of a model on a data set")
@@ -173,23 +175,41 @@ def _run_field(args) -> None:
           f"streamlines ({capped} capped), {int(ref.labels.sum())} label-1 vectors")
 
 
+def _streamline_source(args, domain):
+    """(learned streamline source or None, method name) for --method and --model.
+
+    auto takes a user or shipped model trained on this domain's topology when there is
+    one and traces numerically otherwise; cnn insists on a model.
+    """
+    from .infer.cnn import cnn_streamlines
+    from .infer.models import model_for, user_model_folder
+
+    if args.method == "numerical" and not args.model:
+        return None, "numerical"
+    if args.model:
+        return cnn_streamlines(args.model), "cnn"
+    entry = model_for(domain)
+    if entry is not None:
+        return cnn_streamlines(entry.path), "cnn"
+    if args.method == "cnn":
+        from .infer.signature import topology_signature
+
+        raise UsageError(f"no model for this domain's topology {topology_signature(domain)}: "
+                         f"train one ('quadcnn dataset' + 'quadcnn train'), put it in "
+                         f"{user_model_folder()} or pass --model MODEL.onnx")
+    return None, "numerical"
+
+
 def _run_mesh(args) -> None:
     from .core.export import FORMATS, export
     from .core.pipeline import mesh_domain
 
     out = _check_output(args.output, FORMATS)
     png = _check_output(args.png, {".png"})
-    source = None
-    if args.model:
-        from .infer.cnn import cnn_streamlines
-
-        source = cnn_streamlines(args.model)
-    elif args.method == "cnn":
-        raise UsageError("the cnn method needs a model: --model MODEL.onnx (from 'quadcnn "
-                         "train'); no trained models ship with this version yet")
-    method = "numerical" if args.method == "numerical" else args.method
-    result = mesh_domain(load_domain(args.input), size=args.size, nodes=args.nodes,
-                         method=method, learned_streamlines=source)
+    domain = load_domain(args.input)
+    source, method = _streamline_source(args, domain)
+    result = mesh_domain(domain, size=args.size, nodes=args.nodes, method=method,
+                         learned_streamlines=source)
     if out:
         export(result, out)
     if png:
@@ -243,7 +263,7 @@ def _run_train(args) -> None:
     out = _check_output(args.output, {".onnx"})
     try:
         meta = train(args.data, out, epochs=args.epochs, seed=args.seed, recipe=args.recipe,
-                     threads=args.threads, patience=args.patience)
+                     threads=args.threads, patience=args.patience, minutes=args.minutes)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     m = meta["metrics_test_split"]

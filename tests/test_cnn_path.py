@@ -68,3 +68,44 @@ def test_mesh_command_with_a_model_reports_the_method(untrained, tmp_path):
     assert data["method"] == "cnn"
     assert isinstance(data["fallback"], list)
     assert np.array(data["quads"]).shape[1] == 4
+
+
+def test_auto_picks_a_user_model_of_the_same_topology(untrained, tmp_path, monkeypatch):
+    from quadcnn_wb.infer.models import available_models, model_for
+
+    folder = tmp_path / "models"
+    folder.mkdir()
+    domain = load_domain(SHARED_EXAMPLES / "l_shape.json")
+    model = untrained(topology_signature(domain))
+    for suffix in (".onnx", ".json"):
+        (folder / f"mine{suffix}").write_bytes(model.with_suffix(suffix).read_bytes())
+    (folder / "broken.onnx").write_bytes(b"not a model")
+    (folder / "broken.json").write_text("{ not json")
+    monkeypatch.setenv("QUADCNN_MODELS", str(folder))
+    entry = model_for(domain)
+    assert entry is not None and entry.origin == "user" and entry.path.name == "mine.onnx"
+    assert all(e.path.name != "broken.onnx" for e in available_models())
+    assert model_for(load_domain(SHARED_EXAMPLES / "plate_hole.json")) is None or \
+        model_for(load_domain(SHARED_EXAMPLES / "plate_hole.json")).origin == "shipped"
+    out = tmp_path / "auto.json"
+    result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(out.read_text())["method"] == "cnn"
+    result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", "--method", "numerical",
+                     "-o", out)
+    assert result.returncode == 0 and json.loads(out.read_text())["method"] == "numerical"
+
+
+def test_cnn_without_a_matching_model_is_refused(tmp_path, monkeypatch):
+    monkeypatch.setenv("QUADCNN_MODELS", str(tmp_path))  # empty user folder
+    domain = load_domain(SHARED_EXAMPLES / "l_shape.json")
+    from quadcnn_wb.infer.models import model_for
+
+    if model_for(domain) is not None:
+        pytest.fail("a shipped model for the l_shape topology: pick another shape here")
+    result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", "--method", "cnn",
+                     "-o", tmp_path / "m.json")
+    assert result.returncode == 2
+    assert result.stderr.startswith("error:") and "no model for this domain" in \
+        result.stderr and str(tmp_path) in result.stderr
+    assert not (tmp_path / "m.json").exists()

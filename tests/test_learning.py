@@ -49,26 +49,37 @@ def test_samples_are_deterministic_and_normalised():
     assert 0 < a.y.mean() < 0.2 and set(np.unique(a.y)) == {0, 1}
 
 
-def test_encoding_ignores_placement_scale_and_rotation():
+def _same_up_to_centre_and_scale(a, b):
+    da, db = a[:, :2] - a[:, :2].mean(axis=0), b[:, :2] - b[:, :2].mean(axis=0)
+    scale = np.linalg.norm(da) / np.linalg.norm(db)
+    return np.allclose(db * scale, da, atol=1e-5) and np.allclose(a[:, 2:], b[:, 2:],
+                                                                  atol=1e-5)
+
+
+def test_encoding_ignores_placement_scale_rotation_and_mirror():
     rng = np.random.default_rng(0)
-    nodes = rng.uniform(size=(50, 2))
+    nodes = rng.uniform(size=(50, 2)) * [1.0, 0.6]
     theta = 0.3 + rng.normal(scale=0.1, size=50)
     base, swapped = encode(nodes, theta)
-    assert not swapped.any()
+    assert swapped.all() or not swapped.any()  # a pose change trades every node's labels
     moved, _ = encode(nodes * 1e4 + 7, theta)
     assert np.allclose(base, moved, atol=1e-5)
-    # A rotated copy (the crosses turn with it) gives the same input up to the bbox centre.
-    a = 0.5
-    rot = nodes @ np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
-    turned, _ = encode(rot, theta + a)
-    assert np.allclose(turned[:, 2:], base[:, 2:], atol=1e-6)
-    d_base = base[:, :2] - base[:, :2].mean(axis=0)
-    d_turned = turned[:, :2] - turned[:, :2].mean(axis=0)
-    scale = np.linalg.norm(d_base) / np.linalg.norm(d_turned)
-    quarter = np.array([[0.0, -1.0], [1.0, 0.0]])
-    matches = [np.allclose(d_turned @ np.linalg.matrix_power(quarter, k) * scale, d_base,
-                           atol=1e-5) for k in range(4)]
-    assert any(matches)  # the same input up to a quarter turn
+    # Turned and mirrored copies (the crosses move with them) settle in the same pose, up
+    # to the bounding-box centre and diagonal, which are not turn-invariant.
+    for a in (0.5, 2.0, -2.9):
+        rot = nodes @ np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+        turned, turned_swapped = encode(rot, theta + a)
+        assert _same_up_to_centre_and_scale(base, turned)
+        # Labels follow their arm: the arm that was v1 is v1 again or traded everywhere.
+        arm = canonical_angle(theta + a) - a - canonical_angle(theta)
+        other_arm = np.abs((arm + np.pi / 2) % np.pi - np.pi / 2) > np.pi / 4
+        assert np.array_equal(turned_swapped ^ other_arm, swapped)
+    mirrored, _ = encode(nodes * [-1.0, 1.0], np.pi - theta)
+    assert _same_up_to_centre_and_scale(base, mirrored)
+    # Each of the 8 poses is undone: the settled moments are all non-negative.
+    centred = base[:, :2] - base[:, :2].mean(axis=0)
+    assert (centred[:, 0] ** 2).sum() >= (centred[:, 1] ** 2).sum()
+    assert ((centred ** 3).sum(axis=0) >= 0).all()
     assert np.allclose(canonical_angle(theta + np.pi / 2), canonical_angle(theta), atol=1e-9)
     labels = rng.integers(0, 2, size=(50, 2))
     mask = rng.random(50) < 0.5

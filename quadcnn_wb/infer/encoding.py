@@ -38,7 +38,32 @@ def encode(nodes: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray
     turned = theta - turn
     t = canonical_angle(turned)
     swapped = np.abs(((turned - t) + np.pi / 2) % np.pi - np.pi / 2) > np.pi / 4
-    return np.column_stack([xy, np.cos(t), np.sin(t)]).astype(np.float32), swapped
+    settled, quarter = settle(np.column_stack([xy, np.cos(t), np.sin(t)]))
+    return settled.astype(np.float32), swapped ^ quarter
+
+
+def settle(x: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Points in one of the 8 axis-aligned poses, chosen by the shape's moments.
+
+    After the field turn a part can still lie in any quarter turn and either mirror
+    image; each multiplies what the network must learn.  The pose with the larger
+    second moment along x and non-negative third moments along x and y is unique for
+    any shape that is not symmetric (and for a symmetric one the choice does not
+    matter).  A quarter turn makes v2 the new v1 (returned True: labels trade places);
+    mirrors keep each arm on its axis.
+    """
+    xy, c, s = x[:, :2], x[:, 2], x[:, 3]
+    centred = xy - xy.mean(axis=0)
+    quarter = bool((centred[:, 1] ** 2).sum() > (centred[:, 0] ** 2).sum())
+    if quarter:  # (x, y) -> (-y, x); (c, s) now describes the turned old v2
+        xy = np.column_stack([-xy[:, 1], xy[:, 0]])
+        centred = np.column_stack([-centred[:, 1], centred[:, 0]])
+    signs = np.where((centred ** 3).sum(axis=0) < 0, -1.0, 1.0)
+    xy = xy * signs
+    c, s = c * signs[0], s * signs[1]
+    flip = c < 0  # the same arm pointing to +x, so t stays in (-45°, 45°]
+    c, s = np.where(flip, -c, c), np.where(flip, -s, s)
+    return np.column_stack([xy, c, s]), quarter
 
 
 def swap_labels(labels: np.ndarray, swapped: np.ndarray) -> np.ndarray:

@@ -76,40 +76,90 @@ def with_quartic(x: torch.Tensor) -> torch.Tensor:
     return torch.cat([x, cos4.unsqueeze(-1), sin4.unsqueeze(-1)], dim=-1)
 
 
+def fourier_features(xy: torch.Tensor, octaves: int) -> torch.Tensor:
+    """(B, N, 2) -> (B, N, 4 * octaves): sin and cos of 2^j pi x and y.
+
+    The labels are bands about one element wide; a ReLU network fed raw coordinates
+    learns such sharp functions of position slowly (spectral bias), with these at once.
+    """
+    if octaves == 0:
+        return xy[..., :0]
+    scales = (2.0 ** torch.arange(octaves, dtype=xy.dtype)) * torch.pi
+    angles = (xy.unsqueeze(-1) * scales).flatten(-2)
+    return torch.cat([torch.sin(angles), torch.cos(angles)], dim=-1)
+
+
+def keypoint_offsets(scores: torch.Tensor, pos: torch.Tensor) -> torch.Tensor:
+    """(B, K, N) scores, (B, N, 2) positions -> (B, 2K, N) offsets to K soft keypoints.
+
+    Each channel's softmax over the points places one keypoint (a soft argmax); every
+    point then sees where it lies relative to each.  Streamlines are field lines through
+    singular points and concave corners, so "level with that point" is most of what a
+    label says; with plain max pooling the head must learn coordinates of such points
+    through the one point that wins each channel, which is slow to train.
+    """
+    weights = torch.softmax(scores, dim=-1)
+    centres = weights @ pos  # (B, K, 2)
+    offsets = pos.unsqueeze(1) - centres.unsqueeze(2)  # (B, K, N, 2)
+    return offsets.permute(0, 1, 3, 2).flatten(1, 2)
+
+
 class QuadCNN(nn.Module):
-    def __init__(self, k: int = K_NEIGHBOURS, widths=STAGE_WIDTHS, dropout: float = 0.5):
+    def __init__(self, k: int = K_NEIGHBOURS, widths=STAGE_WIDTHS, dropout: float = 0.5,
+                 dynamic: bool = False, octaves: int = 0, global_width: int = GLOBAL_WIDTH,
+                 head=(256, 256, 128), mean_pool: bool = False, keypoints: int = 0):
         super().__init__()
         self.k = k
+        self.dynamic = dynamic
+        self.octaves = octaves
         self.edge = nn.ModuleList()
         self.point = nn.ModuleList()
-        cin = 6
+        cin = 6 + 4 * octaves
         for w in widths:
             self.edge.append(EdgeConv(cin, w))
             self.point.append(_pointwise(cin, w))
             cin = 2 * w
         local = 2 * sum(widths)
-        self.to_global = _pointwise(local, GLOBAL_WIDTH)
+        self.mean_pool = mean_pool
+        self.to_global = _pointwise(local, global_width)
+        self.keypoints = keypoints
+        if keypoints:
+            self.to_keypoints = nn.Conv1d(local, keypoints, 1)
+        h1, h2, h3 = head
         self.head = nn.Sequential(
-            nn.Conv1d(local + GLOBAL_WIDTH, 256, 1, bias=False), nn.BatchNorm1d(256), nn.ReLU(),
+            nn.Conv1d(local + global_width + 2 * keypoints, h1, 1, bias=False),
+            nn.BatchNorm1d(h1), nn.ReLU(),
             nn.Dropout(dropout),
-            nn.Conv1d(256, 256, 1, bias=False), nn.BatchNorm1d(256), nn.ReLU(),
+            nn.Conv1d(h1, h2, 1, bias=False), nn.BatchNorm1d(h2), nn.ReLU(),
             nn.Dropout(dropout),
-            nn.Conv1d(256, 128, 1, bias=False), nn.BatchNorm1d(128), nn.ReLU(),
-            nn.Conv1d(128, 2, 1))
+            nn.Conv1d(h2, h3, 1, bias=False), nn.BatchNorm1d(h3), nn.ReLU(),
+            nn.Conv1d(h3, 2, 1))
 
     def forward(self, x: torch.Tensor, idx: torch.Tensor | None = None) -> torch.Tensor:
         """(B, N, 4) points -> (B, N, 2) logits."""
         if idx is None:
             with torch.no_grad():
                 idx = knn(x[..., :2], self.k)
-        h = with_quartic(x).transpose(1, 2)
+        h = torch.cat([with_quartic(x), fourier_features(x[..., :2], self.octaves)],
+                      dim=-1).transpose(1, 2)
         stages = []
-        for edge, point in zip(self.edge, self.point):
+        for i, (edge, point) in enumerate(zip(self.edge, self.point)):
+            if self.dynamic and i > 0:
+                with torch.no_grad():
+                    idx = knn(h.transpose(1, 2), self.k)
             h = torch.cat([edge(h, idx), point(h)], dim=1)
             stages.append(h)
         local = torch.cat(stages, dim=1)
-        pooled = self.to_global(local).max(dim=-1, keepdim=True).values
-        joined = torch.cat([local, pooled.expand(-1, -1, local.shape[-1])], dim=1)
+        features = self.to_global(local)
+        pooled = features.max(dim=-1, keepdim=True).values
+        if self.mean_pool:  # half the channels averaged: a gradient for every point
+            half = features.shape[1] // 2
+            pooled = torch.cat([pooled[:, :half], features[:, half:].mean(-1, keepdim=True)],
+                               dim=1)
+        parts = [local, pooled.expand(-1, -1, local.shape[-1])]
+        if self.keypoints:
+            parts.append(keypoint_offsets(self.to_keypoints(local), x[..., :2]))
+        joined = torch.cat(parts, dim=1)
         return self.head(joined).transpose(1, 2)
 
 

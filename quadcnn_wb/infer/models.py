@@ -1,0 +1,74 @@
+"""Where models live and which one fits a domain.
+
+Two folders are searched: the models shipped in `resources/models`, and a per-user folder
+(FreeCAD's user data folder when running inside FreeCAD, `$XDG_DATA_HOME/QuadCNN/models`
+otherwise, `$QUADCNN_MODELS` overriding both) where trained-for-this-design models are
+saved.  A model fits a domain when the topology signature in its metadata equals the
+domain's; user models win over shipped ones, so a retrained model replaces the stock one
+for its topology without touching the installation.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from .predictor import ModelError, load_metadata
+from .signature import topology_signature
+
+SHIPPED_MODELS = Path(__file__).resolve().parents[2] / "resources" / "models"
+
+
+@dataclass(frozen=True)
+class ModelEntry:
+    path: Path
+    family: str
+    topology: str
+    origin: str  # "user" or "shipped"
+
+
+def user_model_folder() -> Path:
+    override = os.environ.get("QUADCNN_MODELS")
+    if override:
+        return Path(override)
+    try:
+        import FreeCAD  # noqa: F401  (present only inside FreeCAD)
+
+        return Path(FreeCAD.getUserAppDataDir()) / "QuadCNN" / "models"
+    except ImportError:
+        base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+        return Path(base) / "QuadCNN" / "models"
+
+
+def available_models(folders=None) -> list[ModelEntry]:
+    """Every readable model with a topology in its metadata, user folder first.
+
+    A model whose metadata is unreadable is skipped here (it cannot be matched); forcing
+    it with --model still reports why.
+    """
+    if folders is None:
+        folders = [(user_model_folder(), "user"), (SHIPPED_MODELS, "shipped")]
+    entries = []
+    for folder, origin in folders:
+        folder = Path(folder)
+        if not folder.is_dir():
+            continue
+        for path in sorted(folder.glob("*.onnx")):
+            try:
+                meta = load_metadata(path)
+            except ModelError:
+                continue
+            if meta.get("topology"):
+                entries.append(ModelEntry(path, str(meta.get("family", path.stem)),
+                                          meta["topology"], origin))
+    return entries
+
+
+def model_for(domain, folders=None) -> ModelEntry | None:
+    """The first model (user before shipped) trained on this domain's topology."""
+    signature = topology_signature(domain)
+    for entry in available_models(folders):
+        if entry.topology == signature:
+            return entry
+    return None
