@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import torch
 from conftest import SHARED_EXAMPLES, run_cli
-from meshcheck import check_quad_mesh
 
+from quadcnn_wb.bench.meshcheck import check_quad_mesh
 from quadcnn_wb.core.domain import load_domain
 from quadcnn_wb.core.pipeline import mesh_domain
 from quadcnn_wb.infer.cnn import cnn_streamlines

@@ -17,7 +17,7 @@ from quadcnn_wb.infer.predictor import ModelError, Predictor
 from quadcnn_wb.learn.dataset import generate, load_dataset, make_sample, save_dataset
 from quadcnn_wb.learn.families import FAMILIES
 from quadcnn_wb.learn.model import QuadCNN, knn
-from quadcnn_wb.learn.train import export_onnx, train
+from quadcnn_wb.learn.train import RECIPES, export_onnx, ridge_targets, train
 
 
 @pytest.mark.parametrize("name", sorted(FAMILIES))
@@ -133,10 +133,12 @@ def test_training_writes_model_and_metadata(tiny):
                                                 "recall", "zero_baseline_accuracy", "samples"}
 
 
-def test_onnx_matches_torch(tiny, tmp_path):
+@pytest.mark.parametrize("architecture", [{}, RECIPES["fast"]["model"]],
+                         ids=["table1", "fast"])
+def test_onnx_matches_torch(tiny, tmp_path, architecture):
     _, _, _, samples = tiny
     torch.manual_seed(1)
-    net = QuadCNN().eval()
+    net = QuadCNN(**architecture).eval()
     path = tmp_path / "parity.onnx"
     export_onnx(net, path)
     predictor = Predictor(path, threads=1)
@@ -149,6 +151,21 @@ def test_onnx_matches_torch(tiny, tmp_path):
         agree += int(np.sum((got >= 0.5) == (ref >= 0.5)))
         total += ref.size
     assert agree / total >= 0.999
+
+
+def test_ridge_targets_keep_the_labels_and_fall_off_with_distance(tiny):
+    _, _, _, samples = tiny
+    sample = samples[0]
+    target = ridge_targets(sample)
+    assert np.array_equal(target >= 0.5, sample.y > 0)
+    for c in range(2):
+        on = sample.y[:, c] > 0
+        off = ~on
+        distance = np.min(np.linalg.norm(sample.x[off, None, :2] - sample.x[None, on, :2],
+                                         axis=-1), axis=1)
+        order = np.argsort(distance)
+        assert np.all(np.diff(target[off, c][order]) <= 1e-7)  # farther, never higher
+        assert target[off, c][order[0]] > 0.2 and target[off, c][order[-1]] < 1e-3
 
 
 def test_evaluate_command(tiny, tmp_path):

@@ -10,9 +10,9 @@ import meshio
 import numpy as np
 import pytest
 from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
-from meshcheck import check_quad_mesh
 from shapes import OWN_SHAPES, named_domain
 
+from quadcnn_wb.bench.meshcheck import check_quad_mesh
 from quadcnn_wb.core.domain import load_domain
 from quadcnn_wb.core.pipeline import mesh_domain
 from quadcnn_wb.core.quantize import side_counts

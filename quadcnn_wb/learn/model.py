@@ -20,6 +20,10 @@ How the inconsistencies of Table 1 are resolved here:
   expanded to every point and joined with the 224 per-point features (736 channels).
 - Head: 1x1 convolutions 256, 256 (dropout 0.5 after each), 128, 2, with batch norm and
   ReLU between them.  About 420k parameters.
+Options beyond Table 1 (all off by default, so QuadCNN() is the paper's network; the
+"fast" training recipe turns them on, see learn.train): Fourier features of the
+positions, keypoint pooling (soft-argmax locations the head sees offsets to), a mean-pooled
+half of the global feature, a dynamic graph for stages 2 and 3 (DGCNN), lighter widths.
 kNN uses topk on minus the squared distance from batched matrix products (no cdist, no
 Python loop over points), so any number of points N works, in training and in ONNX.
 """

@@ -1,4 +1,5 @@
-"""An independent checker for quad meshes (it shares no code with the pipeline)."""
+"""An independent checker for quad meshes: it shares no code with the pipeline, so a
+mesh the pipeline wrongly believes valid is still caught (tests, robustness campaign)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,15 @@ import math
 from collections import Counter
 
 import numpy as np
+
+
+class MeshDefect(AssertionError):
+    """What is wrong with a mesh that claims to be a valid conforming all-quad mesh."""
+
+
+def _require(condition, message: str) -> None:
+    if not condition:
+        raise MeshDefect(message)
 
 
 def quad_areas(nodes, quads):
@@ -25,16 +35,16 @@ def corner_crosses(nodes, quads):
 
 
 def check_quad_mesh(nodes, quads, domain_area, on_boundary):
-    """Assert a valid conforming all-quad mesh; returns the boundary edge node pairs.
+    """Raise MeshDefect unless a valid conforming all-quad mesh; returns the boundary edges.
 
     on_boundary(point) -> bool tells whether a point lies on the domain boundary.
     """
-    assert quads.ndim == 2 and quads.shape[1] == 4
-    assert quads.min() >= 0 and quads.max() < len(nodes)
-    assert all(len(set(q)) == 4 for q in quads.tolist()), "repeated node in a quad"
-    assert np.all(corner_crosses(nodes, quads) > 0), "inverted or degenerate corner"
+    _require(quads.ndim == 2 and quads.shape[1] == 4, "not an (n, 4) array of quads")
+    _require(quads.min() >= 0 and quads.max() < len(nodes), "a quad refers to no node")
+    _require(all(len(set(q)) == 4 for q in quads.tolist()), "repeated node in a quad")
+    _require(np.all(corner_crosses(nodes, quads) > 0), "inverted or degenerate corner")
     areas = quad_areas(nodes, quads)
-    assert np.all(areas > 0), "clockwise quad"
+    _require(np.all(areas > 0), "clockwise quad")
     edges = Counter()
     directed = {}
     for q in quads.tolist():
@@ -42,16 +52,18 @@ def check_quad_mesh(nodes, quads, domain_area, on_boundary):
             a, b = q[k], q[(k + 1) % 4]
             edges[(min(a, b), max(a, b))] += 1
             directed[(min(a, b), max(a, b))] = (a, b)
-    assert max(edges.values()) <= 2, "an edge shared by more than two quads"
+    _require(max(edges.values()) <= 2, "an edge shared by more than two quads")
     boundary_edges = [e for e, c in edges.items() if c == 1]
     for a, b in boundary_edges:
-        assert on_boundary(nodes[a]) and on_boundary(nodes[b]), "hanging node / gap"
+        _require(on_boundary(nodes[a]) and on_boundary(nodes[b]), "hanging node / gap")
     # No overlaps: the quads tile exactly the polygon their boundary edges enclose ...
     enclosed = sum(0.5 * (nodes[a][0] * nodes[b][1] - nodes[b][0] * nodes[a][1])
                    for a, b in (directed[e] for e in boundary_edges))
-    assert math.isclose(areas.sum(), enclosed, rel_tol=1e-9)
+    _require(math.isclose(areas.sum(), enclosed, rel_tol=1e-9),
+             "quads overlap (their areas exceed the area they enclose)")
     # ... which differs from the domain only by chords under curved boundaries.
-    assert math.isclose(areas.sum(), domain_area, rel_tol=1e-2)
+    _require(math.isclose(areas.sum(), domain_area, rel_tol=1e-2),
+             "the quads do not cover the domain's area")
     used = np.unique(quads)
-    assert len(used) == len(nodes), "unused nodes"
+    _require(len(used) == len(nodes), "unused nodes")
     return boundary_edges
