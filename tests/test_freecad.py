@@ -6,6 +6,7 @@ import json
 import os
 import shutil
 import subprocess
+from pathlib import Path
 
 from conftest import REPO
 
@@ -27,6 +28,7 @@ def test_freecadcmd_runs_the_registered_test_module(tmp_path):
 GUI_CHECK = """
 import json, os, traceback
 import FreeCAD, FreeCADGui
+from PySide import QtGui
 result = {}
 try:
     result["listed"] = "QuadCNNWorkbench" in FreeCADGui.listWorkbenches()
@@ -35,20 +37,54 @@ try:
     result["menu_text"] = FreeCADGui.activeWorkbench().MenuText
     result["commands"] = sorted(c for c in FreeCADGui.listCommands()
                                 if c.startswith("QuadCNN_"))
+    main = FreeCADGui.getMainWindow()
+    bars = [b for b in main.findChildren(QtGui.QToolBar) if b.windowTitle() == "QuadCNN"]
+    result["toolbar"] = [a.text() for a in bars[0].actions()] if bars else []
     doc = FreeCAD.openDocument(%(design)r)
     FreeCADGui.Selection.clearSelection()
+    result["enabled_without_selection"] = sorted(
+        c for c in result["commands"] if FreeCADGui.Command.get(c).isActive())
     FreeCADGui.Selection.addSelection(doc.getObject("Plate"))
+    QtGui.QApplication.processEvents()
+    result["enabled_with_sketch"] = sorted(
+        c for c in result["commands"] if FreeCADGui.Command.get(c).isActive())
+    if bars:
+        bars[0].grab().save(os.path.join(%(shots)r, "toolbar.png"))
     FreeCADGui.runCommand("QuadCNN_CreateMesh")
     mesh = [o for o in doc.Objects if o.TypeId == "Fem::FemMeshObjectPython"][0]
     result["valid"] = mesh.isValid()
     result["quads"] = mesh.Quads
     result["mode"] = mesh.ViewObject.DisplayMode
-    result["modes"] = mesh.ViewObject.listDisplayModes()
     result["status"] = mesh.Status
-    FreeCADGui.Selection.clearSelection()
+    QtGui.QApplication.processEvents()
+    result["colours"] = mesh.ViewObject.Proxy.block_colours
+    result["singular_points"] = len(mesh.SingularPoints)
+    from quadcnn_wb.freecad import task_panel
+    result["panel_open"] = bool(task_panel.CURRENT) and FreeCADGui.Control.activeDialog()
+    panel = task_panel.CURRENT[0]
+    result["panel_status"] = panel.form.status.text()
+    panel.form.targetNodes.setValue(1024)
+    panel.form.method.setCurrentIndex(2)
+    panel.clicked(QtGui.QDialogButtonBox.Apply)
+    result["after_apply"] = [mesh.TargetNodes, mesh.Method, panel.form.status.text()]
+    panel.form.resize(420, 330)
+    panel.form.grab().save(os.path.join(%(shots)r, "task_panel.png"))
+    panel.accept()
+    result["panel_closed"] = not FreeCADGui.Control.activeDialog()
     view = FreeCADGui.ActiveDocument.ActiveView
+    graph = view.getSceneGraph()
+    before = graph.getNumChildren()
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(mesh)
+    FreeCADGui.runCommand("QuadCNN_ShowField")
+    result["field_added"] = graph.getNumChildren() - before
+    FreeCADGui.runCommand("QuadCNN_ShowField")
+    result["field_removed"] = graph.getNumChildren() == before
+    FreeCADGui.Selection.clearSelection()
+    doc.getObject(mesh.Name + "_Streamlines").ViewObject.Visibility = True
     view.viewFront()
     FreeCADGui.SendMsgToActiveView("ViewFit")
+    QtGui.QApplication.processEvents()
     view.saveImage(%(image)r, 800, 600, "White")
 except Exception:
     result["error"] = traceback.format_exc()
@@ -57,16 +93,20 @@ with open(%(report)r, "w") as handle:
 os._exit(0)
 """
 
+COMMANDS = ["QuadCNN_CreateMesh", "QuadCNN_ExportMesh", "QuadCNN_RegenerateAll",
+            "QuadCNN_ShowField", "QuadCNN_TrainModel"]
+
 
 def test_workbench_gui_creates_a_mesh_under_xvfb(tmp_path):
     import matplotlib.image
 
     report, image = tmp_path / "gui.json", tmp_path / "view.png"
     design = tmp_path / "design.FCStd"
+    shots = os.environ.get("QUADCNN_SHOTS", str(tmp_path))
     shutil.copyfile(REPO / "resources" / "examples" / "plate_design.FCStd", design)
     script = tmp_path / "gui_check.py"
     script.write_text(GUI_CHECK % {"design": str(design), "image": str(image),
-                                   "report": str(report)})
+                                   "report": str(report), "shots": shots})
     result = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
                              str(script)], capture_output=True, text=True, cwd=tmp_path,
                             env=FREECAD_ENV, timeout=300)
@@ -75,13 +115,28 @@ def test_workbench_gui_creates_a_mesh_under_xvfb(tmp_path):
     assert "error" not in data, data.get("error")
     assert data["listed"] and data["active"] == "QuadCNNWorkbench"
     assert data["menu_text"] == "QuadCNN"
-    assert data["commands"] == ["QuadCNN_CreateMesh", "QuadCNN_ExportMesh",
-                                "QuadCNN_RegenerateAll"]
+    assert data["commands"] == COMMANDS
+    assert len(data["toolbar"]) == len(COMMANDS)
+    # Enabled only when their input is selected.
+    assert data["enabled_without_selection"] == ["QuadCNN_RegenerateAll"] or \
+        data["enabled_without_selection"] == []
+    assert {"QuadCNN_CreateMesh", "QuadCNN_ShowField", "QuadCNN_TrainModel"} <= \
+        set(data["enabled_with_sketch"])
+    assert "QuadCNN_ExportMesh" not in data["enabled_with_sketch"]
     assert data["valid"] and data["quads"] > 100
     assert data["mode"] == "Faces & Wireframe"
+    assert data["colours"] >= 4  # one per block, several blocks
+    assert data["singular_points"] == 4
+    assert data["panel_open"] and "blocks" in data["panel_status"]
+    nodes, method, status = data["after_apply"]
+    assert nodes == 1024 and method == "numerical" and "method numerical" in status
+    assert data["panel_closed"]
+    assert data["field_added"] == 1 and data["field_removed"]
     pixels = matplotlib.image.imread(image)[..., :3]
     assert pixels.std() > 0.05, "the 3D view screenshot is blank"
     assert (pixels.max(axis=2) < 0.3).mean() > 0.01  # the quad edges (near black) are drawn
+    for shot in ("toolbar.png", "task_panel.png"):
+        assert (Path(shots) / shot).stat().st_size > 500
 
 
 def test_headless_demo_edits_regenerates_saves_and_exports(tmp_path):

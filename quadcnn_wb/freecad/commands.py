@@ -1,8 +1,9 @@
 """The workbench's toolbar and menu commands (GUI only; imported by InitGui).
 
-Each command is enabled only when its input is there: CreateMesh needs a selected sketch
-or planar face, ExportMesh a selected QuadCNN mesh, RegenerateAll an open document with
-QuadCNN meshes.
+Each command is enabled only when its input is there: CreateMesh and ShowField need a
+selected sketch or planar face (ShowField also takes a QuadCNN mesh), TrainModel a sketch
+(or a mesh made from one), ExportMesh a selected QuadCNN mesh, RegenerateAll an open
+document with QuadCNN meshes.
 """
 
 from __future__ import annotations
@@ -62,6 +63,77 @@ class CreateMesh:
             FreeCAD.Console.PrintError(f"{mesh.Label}: {mesh.Status}\n")
         FreeCADGui.Selection.clearSelection()
         FreeCADGui.Selection.addSelection(mesh)
+        FreeCADGui.ActiveDocument.setEdit(mesh.Name)  # the task panel, to tune and Apply
+
+
+def _source_or_mesh_source():
+    """The selected sketch/face, or the source of a selected QuadCNN mesh."""
+    meshes = _selected_meshes()
+    if meshes:
+        from .mesh_object import _source_of
+
+        try:
+            return _source_of(meshes[0])
+        except ValueError:
+            return None
+    return _selected_source()
+
+
+def _selected_sketch():
+    source = _source_or_mesh_source()
+    if source is not None and not isinstance(source, tuple) and \
+            source.TypeId.startswith("Sketcher::SketchObject"):
+        return source
+    return None
+
+
+class ShowField:
+    def GetResources(self):
+        return {"Pixmap": resource_path("icons", "QuadCNN_ShowField.svg"),
+                "MenuText": "Show frame field",
+                "ToolTip": "Show (again: hide) the frame field of the selected shape: crosses, "
+                           "singular points by valence, and the network's label-1 vectors",
+                "StatusTip": "Select a sketch, a planar face or a QuadCNN mesh first"}
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and _source_or_mesh_source() is not None
+
+    def Activated(self):
+        from ..core.domain import DomainError
+        from .field_view import toggle
+        from .geometry import face_to_domain, source_shape_and_placement
+        from .preferences import target_nodes
+
+        source = _source_or_mesh_source()
+        label = source[0].Label if isinstance(source, tuple) else source.Label
+        try:
+            face, plane, placement = source_shape_and_placement(source)
+            domain = face_to_domain(face, plane, label)
+            FreeCADGui.getMainWindow().statusBar().showMessage("QuadCNN: computing the field…")
+            text = toggle(FreeCADGui.ActiveDocument.ActiveView, domain, placement,
+                          target_nodes())
+        except (DomainError, ValueError, RuntimeError) as exc:
+            FreeCAD.Console.PrintError(f"{label}: {' '.join(str(exc).split())}\n")
+            return
+        FreeCAD.Console.PrintMessage(f"{label}: {text}\n")
+        FreeCADGui.getMainWindow().statusBar().showMessage(f"QuadCNN: {text}", 8000)
+
+
+class TrainModel:
+    def GetResources(self):
+        return {"Pixmap": resource_path("icons", "QuadCNN_TrainModel.svg"),
+                "MenuText": "Train model for this design",
+                "ToolTip": "Vary the selected sketch's dimensions, learn its streamlines in "
+                           "the background, and use the model for its meshes",
+                "StatusTip": "Select a sketch (or a QuadCNN mesh made from one) first"}
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and _selected_sketch() is not None
+
+    def Activated(self):
+        from .train_dialog import train_for
+
+        train_for(_selected_sketch())
 
 
 class ExportMesh:
@@ -117,7 +189,8 @@ class RegenerateAll:
                                      + "\n")
 
 
-COMMANDS = {"QuadCNN_CreateMesh": CreateMesh, "QuadCNN_ExportMesh": ExportMesh,
+COMMANDS = {"QuadCNN_CreateMesh": CreateMesh, "QuadCNN_ShowField": ShowField,
+            "QuadCNN_TrainModel": TrainModel, "QuadCNN_ExportMesh": ExportMesh,
             "QuadCNN_RegenerateAll": RegenerateAll}
 
 

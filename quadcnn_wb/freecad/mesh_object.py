@@ -42,10 +42,24 @@ PROPERTIES = (
      "Streamlines the cnn path had to trace numerically"),
     ("App::PropertyString", "Timings", "Results", "Seconds per stage (JSON)"),
     ("App::PropertyString", "Status", "Results", "ok, or what went wrong last time"),
+    ("App::PropertyVectorList", "SingularPoints", "Results",
+     "Singular points of the frame field (global coordinates)"),
+    ("App::PropertyIntegerList", "SingularValences", "Results",
+     "Valence of each singular point (3 or 5)"),
 )
 READ_ONLY = ("Blocks", "Quads", "Singularities", "MinScaledJacobian", "IrregularVertices",
-             "MethodUsed", "Fallbacks", "Timings", "Status")
+             "MethodUsed", "Fallbacks", "Timings", "Status", "SingularPoints",
+             "SingularValences", "ModelEntry")
 DEFAULTS = {"Method": ["auto", "cnn", "numerical"], "TargetNodes": 2048, "Smoothing": True}
+
+
+def preferred_defaults(obj) -> None:
+    """A new object starts from the user's preferences (Edit → Preferences → QuadCNN)."""
+    from . import preferences
+
+    obj.Method = preferences.method()
+    obj.TargetNodes = preferences.target_nodes()
+    obj.ElementSize = preferences.element_size()
 
 
 def add_properties(obj) -> None:
@@ -79,7 +93,7 @@ class QuadMeshProxy(Stateless):
     def execute(self, obj):
         from ..core.domain import DomainError
         from ..core.pipeline import mesh_domain
-        from .geometry import face_to_domain, source_shape_and_placement
+        from .geometry import face_to_domain, source_shape_and_placement, to_global
         from .mesh_builder import fem_mesh, update_companions
 
         started = time.perf_counter()
@@ -90,14 +104,7 @@ class QuadMeshProxy(Stateless):
             face, plane, placement = source_shape_and_placement(source)
             label = source[0].Label if isinstance(source, tuple) else source.Label
             domain = face_to_domain(face, plane, label)
-            learned = None
-            if obj.Model and obj.Method != "numerical":
-                from ..infer.cnn import cnn_streamlines
-
-                learned = cnn_streamlines(obj.Model)
-            elif obj.Method == "cnn":
-                raise ValueError("the cnn method needs a model: set the Model property to a "
-                                 "trained .onnx")
+            learned = _learned_source(obj, domain)
             size = float(obj.ElementSize) or None
             result = mesh_domain(domain, size=size, nodes=int(obj.TargetNodes),
                                  method=obj.Method, smoothing=bool(obj.Smoothing),
@@ -114,7 +121,10 @@ class QuadMeshProxy(Stateless):
         update_companions(obj, result, placement)
         q = result.quality
         obj.Blocks, obj.Quads = q["blocks"], q["quads"]
-        obj.Singularities = len(result.reference.field.singularities)
+        singular = result.reference.field.singularities
+        obj.Singularities = len(singular)
+        obj.SingularPoints = to_global(placement, [s.xy.tolist() for s in singular])
+        obj.SingularValences = [int(s.valence) for s in singular]
         obj.MinScaledJacobian = q["min_scaled_jacobian"]
         obj.IrregularVertices = q["irregular_vertices"]
         obj.MethodUsed = result.method
@@ -125,6 +135,37 @@ class QuadMeshProxy(Stateless):
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {result.problem}\n")
         FreeCAD.Console.PrintLog(f"{obj.Label}: {q['quads']} quads in "
                                  f"{time.perf_counter() - started:.2f} s\n")
+
+
+def _learned_source(obj, domain):
+    """The model's streamline source for this object, or None for numerical tracing.
+
+    An embedded model (the Model property) wins; otherwise auto and cnn look in the user
+    model folder and the shipped models for one trained on the domain's topology, and the
+    one found is named in ModelEntry.
+    """
+    from ..infer.cnn import cnn_streamlines
+    from . import preferences
+
+    if obj.Method == "numerical":
+        return None
+    if obj.Model:
+        obj.ModelEntry = "embedded"
+        return cnn_streamlines(obj.Model, threads=preferences.threads())
+    from ..infer.models import model_for, user_model_folder
+
+    entry = model_for(domain)
+    if entry is not None:
+        obj.ModelEntry = f"{entry.origin}: {entry.path.name}"
+        return cnn_streamlines(entry.path, threads=preferences.threads())
+    obj.ModelEntry = ""
+    if obj.Method == "cnn":
+        from ..infer.signature import topology_signature
+
+        raise ValueError(f"no model for this shape's topology {topology_signature(domain)}: "
+                         f"embed one in Model, put one in {user_model_folder()}, or train "
+                         f"one (QuadCNN_TrainModel)")
+    return None
 
 
 def _source_of(obj):
@@ -148,6 +189,7 @@ def make_quad_mesh(doc, source, name: str = "QuadMesh", **properties):
     else:
         obj.Source = (source, [])
         obj.Part = source
+    preferred_defaults(obj)
     for key, value in properties.items():
         setattr(obj, key, value)
     obj.StreamlineWires = doc.addObject("Part::Feature", f"{obj.Name}_Streamlines")

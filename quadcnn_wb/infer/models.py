@@ -1,11 +1,11 @@
 """Where models live and which one fits a domain.
 
 Two folders are searched: the models shipped in `resources/models`, and a per-user folder
-(FreeCAD's user data folder when running inside FreeCAD, `$XDG_DATA_HOME/QuadCNN/models`
-otherwise, `$QUADCNN_MODELS` overriding both) where trained-for-this-design models are
-saved.  A model fits a domain when the topology signature in its metadata equals the
-domain's; user models win over shipped ones, so a retrained model replaces the stock one
-for its topology without touching the installation.
+(inside FreeCAD the folder set in the preferences, else FreeCAD's user data folder;
+`$XDG_DATA_HOME/QuadCNN/models` outside; `$QUADCNN_MODELS` overriding all) where
+trained-for-this-design models are saved.  A model fits a domain when the topology
+signature in its metadata equals the domain's; user models win over shipped ones, so a
+retrained model replaces the stock one for its topology without touching the installation.
 """
 
 from __future__ import annotations
@@ -33,9 +33,13 @@ def user_model_folder() -> Path:
     if override:
         return Path(override)
     try:
-        import FreeCAD  # noqa: F401  (present only inside FreeCAD)
+        import FreeCAD  # present only inside FreeCAD
 
-        return Path(FreeCAD.getUserAppDataDir()) / "QuadCNN" / "models"
+        from ..freecad.preferences import model_folder
+
+        chosen = model_folder()
+        return Path(chosen) if chosen else Path(FreeCAD.getUserAppDataDir()) / "QuadCNN" / \
+            "models"
     except ImportError:
         base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
         return Path(base) / "QuadCNN" / "models"

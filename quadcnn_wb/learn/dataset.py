@@ -40,12 +40,30 @@ class Sample:
     y: np.ndarray  # (N, 2) uint8
 
 
-def make_sample(family_name: str, seed: int, index: int, nodes: int = 2048):
-    """(Sample, None) or (None, reason it was dropped)."""
+@dataclass(frozen=True)
+class Variants:
+    """Design variants of one shape (e.g. a sketch with its dimensions varied) standing in
+    for a family: sample i starts from variant i modulo their number."""
+
+    domains: tuple  # Domain JSON dicts
+    singularities: tuple  # (valence-3, valence-5) every variant must keep
+    name: str = "design"
+
+
+def _draw(source, rng, index):
+    """(domain, singular counts it must have) for sample `index` of a family or variants."""
+    if isinstance(source, Variants):
+        return (domain_from_json(source.domains[index % len(source.domains)]),
+                source.singularities)
+    fam = family(source)
+    return fam.sample(rng)[1], fam.singularities
+
+
+def make_sample(source, seed: int, index: int, nodes: int = 2048):
+    """(Sample, None) or (None, reason it was dropped); source: a family name or Variants."""
     rng = np.random.default_rng([seed, index])
-    fam = family(family_name)
     try:
-        _, domain = fam.sample(rng)
+        domain, singularities = _draw(source, rng, index)
         matrix = similarity(rng.uniform(0, 360), scale=rng.uniform(0.5, 2.0),
                             mirror=bool(rng.integers(2)))
         domain = domain_from_json(transform_domain_json(domain.to_json(), matrix))
@@ -55,7 +73,7 @@ def make_sample(family_name: str, seed: int, index: int, nodes: int = 2048):
     except Exception as exc:  # a generator must survive any single bad draw
         return None, f"{type(exc).__name__}"
     counts = ref.field.valences()
-    if (counts[3], counts[5]) != fam.singularities:
+    if (counts[3], counts[5]) != tuple(singularities):
         return None, "singular points differ from the family's"
     if any(line.capped for line in ref.streamlines):
         return None, "a streamline had to be capped"
@@ -72,12 +90,16 @@ def _work(args):
     return args[2], make_sample(*args)
 
 
-def generate(family_name: str, n: int, seed: int, nodes: int = 2048, workers: int | None = None,
+def generate(source, n: int, seed: int, nodes: int = 2048, workers: int | None = None,
              progress=True):
-    """Samples (in index order) and a Counter of drop reasons."""
-    family(family_name)  # fail early on an unknown family
+    """Samples (in index order) and a Counter of drop reasons.
+
+    progress: True for a bar on stderr, a callable (done, total) for anything else.
+    """
+    if not isinstance(source, Variants):
+        family(source)  # fail early on an unknown family
     workers = workers or os.cpu_count() or 1
-    jobs = [(family_name, seed, i, nodes) for i in range(n)]
+    jobs = [(source, seed, i, nodes) for i in range(n)]
     results = {}
     started = time.perf_counter()
     if workers == 1:
@@ -89,13 +111,15 @@ def generate(family_name: str, n: int, seed: int, nodes: int = 2048, workers: in
     try:
         for done, (i, result) in enumerate(iterator, start=1):
             results[i] = result
-            if progress:
+            if callable(progress):
+                progress(done, n)
+            elif progress:
                 _progress(done, n, started)
     finally:
         if pool is not None:
             pool.close()
             pool.join()
-    if progress:
+    if progress is True:
         print(file=sys.stderr)
     samples, dropped = [], Counter()
     for i in range(n):

@@ -126,12 +126,14 @@ def best_threshold(probabilities, samples, indices) -> float:
 
 def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "paper",
           threads: int = 2, patience: int = 6, progress: bool = True,
-          minutes: float | None = None, monitor: int = 100) -> dict:
+          minutes: float | None = None, monitor: int = 100, report=None,
+          meta_extra: dict | None = None) -> dict:
     """Train, keep the best epoch by validation IoU, export ONNX and its metadata.
 
     `minutes` bounds the wall time (the epoch under way stops, the best model so far is
     kept); `monitor` validation samples choose the best epoch, the whole validation split
-    gives the reported metrics and the decision threshold.
+    gives the reported metrics and the decision threshold.  `report(fraction, text)`, when
+    given, hears about every step (the FreeCAD training dialog's progress bar).
     """
     if recipe not in RECIPES:
         raise ValueError(f"unknown recipe {recipe!r} (known: {', '.join(RECIPES)})")
@@ -182,6 +184,9 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
             if schedule is not None:
                 schedule.step()
             losses.append(float(loss.detach()))
+            if report is not None:
+                report(((epoch - 1) * steps_per_epoch + step) / (epochs * steps_per_epoch),
+                       f"epoch {epoch}/{epochs}, loss {np.mean(losses):.3f}")
             if progress:
                 sys.stderr.write(f"\repoch {epoch}/{epochs} step {step}/{steps_per_epoch} "
                                  f"loss {np.mean(losses):.4f} ")
@@ -209,7 +214,7 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
     val = metrics_at(probabilities, samples, val_idx, threshold)
     export_onnx(net, out_path)
     metadata = {
-        "family": meta.get("family"), "topology": meta.get("topology"),
+        "family": meta.get("family"), "topology": meta.get("topology"), **(meta_extra or {}),
         "input": ENCODING, "input_shape": ["batch", "points", 4],
         "output": "probabilities of label 1 for v1 and v2", "threshold": threshold,
         "architecture": {"k": net.k, **architecture},
