@@ -78,6 +78,12 @@ try:
     FreeCADGui.Selection.addSelection(mesh)
     FreeCADGui.runCommand("QuadCNN_ShowField")
     result["field_added"] = graph.getNumChildren() - before
+    mesh.ViewObject.Visibility = False
+    view.viewFront()
+    FreeCADGui.SendMsgToActiveView("ViewFit")
+    QtGui.QApplication.processEvents()
+    view.saveImage(os.path.join(%(shots)r, "field_view.png"), 800, 600, "White")
+    mesh.ViewObject.Visibility = True
     FreeCADGui.runCommand("QuadCNN_ShowField")
     result["field_removed"] = graph.getNumChildren() == before
     FreeCADGui.Selection.clearSelection()
@@ -135,7 +141,7 @@ def test_workbench_gui_creates_a_mesh_under_xvfb(tmp_path):
     pixels = matplotlib.image.imread(image)[..., :3]
     assert pixels.std() > 0.05, "the 3D view screenshot is blank"
     assert (pixels.max(axis=2) < 0.3).mean() > 0.01  # the quad edges (near black) are drawn
-    for shot in ("toolbar.png", "task_panel.png"):
+    for shot in ("toolbar.png", "task_panel.png", "field_view.png"):
         assert (Path(shots) / shot).stat().st_size > 500
 
 

@@ -66,16 +66,30 @@ class ViewProviderQuadMesh(Stateless):
         vobj.Proxy = self
 
     def attach(self, vobj):
+        from pivy import coin
+
         self.Object = vobj.Object
         self.ViewObject = vobj
+        # Our own nodes sit beside FEM's display-mode switch, which Visibility does not
+        # reach: they get a switch of their own, kept in step in onChanged.
+        self.extras = coin.SoSwitch()
+        self.extras.whichChild = coin.SO_SWITCH_ALL
+        vobj.RootNode.addChild(self.extras)
         self._add_singular_markers(vobj)
         self._add_edge_lines(vobj)
+
+    def onChanged(self, vobj, prop):
+        if prop == "Visibility" and hasattr(self, "extras"):
+            from pivy import coin
+
+            self.extras.whichChild = coin.SO_SWITCH_ALL if vobj.Visibility else \
+                coin.SO_SWITCH_NONE
 
     def _add_singular_markers(self, vobj):
         from pivy import coin
 
         self.marks = coin.SoAnnotation()  # drawn last, over the faces, never hidden
-        vobj.RootNode.addChild(self.marks)
+        self.extras.addChild(self.marks)
 
     def _show_singular_points(self, obj):
         from pivy import coin
@@ -130,7 +144,7 @@ class ViewProviderQuadMesh(Stateless):
         sep = coin.SoSeparator()
         for node in (offset, style, overall_binding(coin), colour, self.coords, self.lines):
             sep.addChild(node)
-        vobj.RootNode.addChild(sep)
+        self.extras.addChild(sep)
         self.updateData(vobj.Object, "FemMesh")
 
     def updateData(self, obj, prop):
