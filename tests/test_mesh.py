@@ -118,7 +118,7 @@ def test_mesh_command_json_contract(tmp_path):
 
 
 def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
-    for args, message in ((["--method", "cnn"], "cnn method needs a model"),
+    for args, message in ((["--method", "cnn"], "no model for this domain's topology"),
                           (["--size", "-1"], "expected a positive size"),
                           (["-o", str(tmp_path / "m.stl")], "output must end in")):
         result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", *args)

@@ -20,6 +20,7 @@ from ..core.background import _build_geometry
 from ..core.gmsh_quads import read_quads
 from ..core.gmsh_session import gmsh_session
 from ..core.pipeline import DEFAULT_SIZE_DIVISOR, mesh_domain
+from ..core.pose import Pose
 from ..core.quadmesh import scaled_jacobians
 from ..core.quality import boundary_quads_expected, irregular_vertices
 from .common import bundled_examples
@@ -28,7 +29,7 @@ from .common import bundled_examples
 def gmsh_quasi_structured(domain, size: float):
     """(nodes, quads, boundary mask, seconds) from gmsh's algorithm 11."""
     with gmsh_session() as session:
-        _build_geometry(domain, np.zeros(2), 1.0)
+        _build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
         for name, value in (("Mesh.Algorithm", 11), ("Mesh.MeshSizeMin", size),
                             ("Mesh.MeshSizeMax", size), ("Mesh.MeshSizeFromPoints", 0),
                             ("Mesh.MeshSizeFromCurvature", 0)):

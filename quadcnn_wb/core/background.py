@@ -19,6 +19,7 @@ import numpy as np
 from .curves import Arc, cross2
 from .domain import Domain
 from .gmsh_session import gmsh_session
+from .pose import Pose, canonical_pose
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
@@ -120,14 +121,14 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1) -> Back
     """Triangulate the domain with ``nodes`` nodes, within NODE_TOLERANCE or NODE_SLACK."""
     if nodes < 8:
         raise ValueError(f"--nodes must be at least 8, got {nodes}")
-    scale, center = domain.size, domain.center
-    unit_area = domain.area / scale**2
-    unit_perimeter = domain.perimeter / scale
+    pose = canonical_pose(domain)
+    unit_area = unit(domain.area / pose.scale**2)
+    unit_perimeter = unit(domain.perimeter / pose.scale)
     h = size_for_nodes(unit_area, unit_perimeter, domain.holes, nodes / GMSH_DENSITY)
     tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
     with gmsh_session(threads) as session:
-        curve_tags = _build_geometry(domain, center, scale)
+        curve_tags = _build_geometry(domain, pose)
         for option, value in (("Mesh.Algorithm", GMSH_ALGORITHM),
                               ("Mesh.MeshSizeFromPoints", 0),
                               ("Mesh.MeshSizeFromCurvature", 0),
@@ -151,37 +152,71 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1) -> Back
         raise BackgroundMeshError(
             f"could not reach {nodes} nodes within {NODE_TOLERANCE:.0%} (best "
             f"{len(coords)}); the shape may have features far below the element size")
-    coords = coords * scale + center
-    return _assemble(domain, coords, triangles, curve_nodes, h * scale)
+    coords = pose.from_unit(coords)
+    return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale)
 
 
-def _build_geometry(domain: Domain, center, scale) -> dict:
+UNIT_DIGITS = 12  # unit coordinates are rounded to this many decimals before gmsh
+
+
+def unit(value):
+    """Round unit-scaled values so that a moved or rescaled copy of a part gives gmsh the
+    very same numbers (not numbers a rounding error apart, which can flip a Delaunay
+    decision and change the whole mesh)."""
+    return np.round(value, UNIT_DIGITS)
+
+
+def _unit_loops(domain: Domain, pose: Pose):
+    """The loops in unit coordinates, in an order that depends on the shape alone.
+
+    Each loop is a list of (loop index, segment index, start, middle or None, end) with the
+    domain on the left in the pose (a mirrored pose reverses the loops), starting at its
+    lowest-then-leftmost vertex; holes sorted by that vertex.  Full circles are
+    (loop index, centre, radius).
+    """
+    loops = []
+    for li, loop in enumerate(domain.loops):
+        if len(loop) == 1 and isinstance(loop[0], Arc) and loop[0].is_full:
+            c = loop[0]
+            loops.append((li, unit(pose.to_unit(c.center)), unit(c.radius / pose.scale)))
+            continue
+        pieces = []
+        for si, c in enumerate(loop):
+            mid = unit(pose.to_unit(c.midpoint())) if isinstance(c, Arc) else None
+            pieces.append((li, si, unit(pose.to_unit(c.p0)), mid, unit(pose.to_unit(c.p1))))
+        if pose.mirrored:
+            pieces = [(li, si, end, mid, start) for li, si, start, mid, end in pieces[::-1]]
+        first = min(range(len(pieces)), key=lambda k: (pieces[k][2][1], pieces[k][2][0]))
+        loops.append(pieces[first:] + pieces[:first])
+
+    def start_key(loop):
+        point = loop[1] if isinstance(loop, tuple) else loop[0][2]
+        return (point[1], point[0])
+
+    return [loops[0]] + sorted(loops[1:], key=start_key)
+
+
+def _build_geometry(domain: Domain, pose: Pose) -> dict:
     """OCC curves for every domain curve, in unit coordinates; returns tag -> (loop, seg)."""
     occ = gmsh.model.occ
     curve_tags = {}
     loop_tags = []
     helpers = []
-
-    def add_point(p):
-        q = (np.asarray(p) - center) / scale
-        return occ.addPoint(q[0], q[1], 0.0)
-
-    for li, loop in enumerate(domain.loops):
-        if len(loop) == 1 and isinstance(loop[0], Arc) and loop[0].is_full:
-            c = loop[0]
-            q = (c.center - center) / scale
-            tag = occ.addCircle(q[0], q[1], 0.0, c.radius / scale)
+    for loop in _unit_loops(domain, pose):
+        if isinstance(loop, tuple):
+            li, q, radius = loop
+            tag = occ.addCircle(q[0], q[1], 0.0, radius)
             curve_tags[tag] = (li, 0)
             loop_tags.append(occ.addCurveLoop([tag]))
             continue
-        vertices = [add_point(c.p0) for c in loop]
+        vertices = [occ.addPoint(start[0], start[1], 0.0) for _, _, start, _, _ in loop]
         tags = []
-        for si, c in enumerate(loop):
-            start, end = vertices[si], vertices[(si + 1) % len(loop)]
-            if isinstance(c, Arc):
-                mid = add_point(c.midpoint())
-                helpers.append(mid)
-                tag = occ.addCircleArc(start, mid, end, center=False)
+        for k, (li, si, _, mid, _) in enumerate(loop):
+            start, end = vertices[k], vertices[(k + 1) % len(loop)]
+            if mid is not None:
+                helper = occ.addPoint(mid[0], mid[1], 0.0)
+                helpers.append(helper)
+                tag = occ.addCircleArc(start, helper, end, center=False)
             else:
                 tag = occ.addLine(start, end)
             curve_tags[tag] = (li, si)
@@ -228,6 +263,9 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMe
             t = np.array([curve.project(coords[i]) for i in ids])
             if isinstance(curve, Arc) and curve.is_full:
                 t[t >= 1.0 - 1e-9] = 0.0
+            else:  # the vertices themselves, exactly (the pose's round trip is not exact)
+                t[t <= 1e-9] = 0.0
+                t[t >= 1.0 - 1e-9] = 1.0
             order = np.argsort(t, kind="stable")
             ids, t = ids[order], t[order]
             if not (isinstance(curve, Arc) and curve.is_full):

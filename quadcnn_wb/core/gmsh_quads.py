@@ -12,13 +12,15 @@ import numpy as np
 
 from .background import _build_geometry
 from .gmsh_session import gmsh_session
+from .pose import canonical_pose
 from .quadmesh import QuadMesh, _counter_clockwise, smooth
 
 
 def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
-    scale, center = domain.size, domain.center
+    pose = canonical_pose(domain)
+    scale = pose.scale
     with gmsh_session() as session:
-        curve_tags = _build_geometry(domain, center, scale)
+        curve_tags = _build_geometry(domain, pose)
         for name, value in (("Mesh.Algorithm", 8), ("Mesh.RecombineAll", 1),
                             ("Mesh.RecombinationAlgorithm", 1),
                             ("Mesh.SubdivisionAlgorithm", 1),
@@ -28,7 +30,7 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
             session.set(name, value)
         gmsh.model.mesh.generate(2)
         nodes, quads, index = read_quads()
-        nodes = nodes * scale + center
+        nodes = pose.from_unit(nodes)
         boundary = np.zeros(len(nodes), dtype=bool)
         for tag, (li, si) in curve_tags.items():
             btags, _, _ = gmsh.model.mesh.getNodes(1, tag, includeBoundary=True)

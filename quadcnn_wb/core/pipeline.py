@@ -17,13 +17,14 @@ from .cuts import connecting_cuts
 from .domain import Domain
 from .gmsh_quads import gmsh_quad_mesh
 from .partition import Partition, PartitionError, build_partition
+from .pose import diameter
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality
 from .quantize import quantize
 from .reference import Reference, background_and_field
 from .tracing import trace_streamlines
 
-DEFAULT_SIZE_DIVISOR = 40  # default element size: the domain diagonal / this
+DEFAULT_SIZE_DIVISOR = 40  # default element size: the part's diameter / this
 MIN_VALID_JACOBIAN = 0.05  # a block-structured mesh worse than this is not handed out
 
 
@@ -66,7 +67,9 @@ class MeshResult:
 
 
 def default_size(domain: Domain) -> float:
-    return domain.size / DEFAULT_SIZE_DIVISOR
+    """The part's diameter / 40: the bounding-box diagonal for rectangles, and unlike it
+    the same for a turned copy."""
+    return diameter(domain) / DEFAULT_SIZE_DIVISOR
 
 
 def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,

@@ -161,6 +161,7 @@ def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarr
     degree = np.bincount(edges.ravel(), minlength=n).astype(float)
     free = ~fixed & (degree > 0)
     x = nodes.copy()
+    span = float(np.ptp(x, axis=0).max())
     quality = scaled_jacobians(x, quads)
     for _ in range(iterations):
         summed = np.zeros_like(x)
@@ -169,19 +170,20 @@ def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarr
         proposal = x.copy()
         proposal[free] = summed[free] / degree[free, None]
         new_quality = scaled_jacobians(proposal, quads)
-        bad = new_quality < np.minimum(quality, SMOOTH_FLOOR)
+        # The margin keeps rounding noise from deciding (a turned copy must decide alike).
+        bad = new_quality < np.minimum(quality, SMOOTH_FLOOR) - 1e-12
         for _ in range(10):
             if not bad.any():
                 break
             undo = np.unique(quads[bad].ravel())
             proposal[undo] = x[undo]
             new_quality = scaled_jacobians(proposal, quads)
-            bad = new_quality < np.minimum(quality, SMOOTH_FLOOR)
+            bad = new_quality < np.minimum(quality, SMOOTH_FLOOR) - 1e-12
         if bad.any():
             break
-        moved = float(np.abs(proposal - x).max())
+        moved = float(np.hypot(*(proposal - x).T).max())
         x, quality = proposal, new_quality
-        if moved < 1e-12:
+        if moved < 1e-12 * span:
             break
     return x
 
@@ -193,6 +195,27 @@ def _sj_batch(p) -> np.ndarray:
     cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
     norm = np.hypot(a[..., 0], a[..., 1]) * np.hypot(b[..., 0], b[..., 1])
     return np.min(np.where(norm > 0, cross / np.maximum(norm, 1e-300), -1.0), axis=-1)
+
+
+def _visiting_order(x, quads, sj, vertices):
+    """Worst first, then nearest the middle: geometry, not numbering, decides (the node
+    numbers of a turned copy differ)."""
+    worst_around = np.full(len(x), np.inf)
+    np.minimum.at(worst_around, quads.ravel(), np.repeat(sj, 4))
+    span = float(np.ptp(x, axis=0).max()) or 1.0
+    middle = np.hypot(*(x[vertices] - x.mean(axis=0)).T) / span
+    keys = np.lexsort((np.round(middle, 9), worst_around[vertices]))
+    return vertices[keys]
+
+
+def _reference_direction(offsets, reach):
+    """(cos, sin) of the direction the compass is measured from: towards the mean of the
+    surrounding corners, or (a symmetric star) towards the farthest corner."""
+    mean = offsets.mean(axis=0)
+    if np.hypot(*mean) > 1e-6 * reach:
+        return mean / np.hypot(*mean)
+    far = offsets[int(np.argmax(np.round(np.hypot(*offsets.T) / reach, 9)))]
+    return far / np.hypot(*far)
 
 
 def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02) -> np.ndarray:
@@ -209,17 +232,23 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02) ->
     compass = np.stack([np.cos(angles), np.sin(angles)], axis=1)
     steps = np.concatenate([0.1 * compass, 0.03 * compass])
     for _ in range(passes):
-        sj = scaled_jacobians(x, quads)
-        worst = np.argsort(sj)[: max(4, int(share * len(quads)))]
+        # Rounded and stable: a turned copy of the mesh visits the same nodes in the same
+        # order (rounding noise must not reorder near-ties).
+        sj = np.round(scaled_jacobians(x, quads), 12)
+        worst = np.argsort(sj, kind="stable")[: max(4, int(share * len(quads)))]
         improved = False
-        for v in np.unique(quads[worst].ravel()):
+        for v in _visiting_order(x, quads, sj, np.unique(quads[worst].ravel())):
             if fixed[v]:
                 continue
             around = quads[order[starts[v]:starts[v + 1]] // 4]
             corners = x[around]  # (k, 4, 2)
             current = _sj_batch(corners).min()
             reach = np.hypot(*(corners.reshape(-1, 2) - x[v]).T).max()
-            trial = x[v] + reach * steps  # (T, 2)
+            # Compass directions measured from an edge of the node, not from the axes, so
+            # that a turned or mirrored mesh tries the turned or mirrored moves.
+            c, s = _reference_direction(corners.reshape(-1, 2) - x[v], reach)
+            frame = np.array([[c, -s], [s, c]])
+            trial = x[v] + reach * steps @ frame.T  # (T, 2)
             batch = np.repeat(corners[None], len(trial), axis=0)
             mask = around == v
             batch[:, mask] = trial[:, None, :]

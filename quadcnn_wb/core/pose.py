@@ -1,0 +1,145 @@
+"""The pose a part is meshed in: the same for every turned, mirrored, moved or rescaled
+copy of it, so that those copies get the transformed mesh and not merely a similar one.
+
+gmsh's triangulation depends on where the part lies and in which order its curves come;
+handing it the part in a pose computed from the geometry alone (centroid at the origin,
+unit diameter, a chosen straight edge along +x with the part above it, a chosen mirror
+image, loops started at a chosen vertex) makes every copy look identical to gmsh.
+Choices are made on keys rounded to KEY_DIGITS, so rounding noise cannot flip them; where
+keys tie the part is symmetric (or nearly) and any choice gives the same mesh up to that
+symmetry.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .curves import Arc, Line
+
+KEY_DIGITS = 9  # relative precision of the keys that choose the pose
+SAMPLES_PER_CURVE = 16  # boundary samples at fixed parameters (they move with the part)
+
+
+@dataclass(frozen=True)
+class Pose:
+    center: np.ndarray  # the region's centroid, in part coordinates
+    scale: float  # the part's diameter
+    matrix: np.ndarray  # orthogonal 2x2 (det -1 for a mirror): part -> pose directions
+
+    @property
+    def mirrored(self) -> bool:
+        return float(np.linalg.det(self.matrix)) < 0
+
+    def to_unit(self, p) -> np.ndarray:
+        return (np.asarray(p, dtype=float) - self.center) @ self.matrix.T / self.scale
+
+    def from_unit(self, q) -> np.ndarray:
+        return np.asarray(q, dtype=float) * self.scale @ self.matrix + self.center
+
+
+def boundary_samples(domain) -> np.ndarray:
+    """Points at fixed curve parameters, both ends included: a turned or mirrored copy of
+    the part gives the turned or mirrored set (whatever the direction of its curves)."""
+    t = np.linspace(0.0, 1.0, SAMPLES_PER_CURVE + 1)
+    points = []
+    for loop in domain.loops:
+        for curve in loop:
+            if isinstance(curve, Arc) and curve.is_full:
+                continue  # its start angle is arbitrary; circles enter the diameter exactly
+            points.append(curve.point(t))
+    return np.concatenate(points) if points else np.zeros((0, 2))
+
+
+def diameter(domain) -> float:
+    """The largest distance across the part (rotation-invariant, unlike the bounding box
+    diagonal; the same as it for rectangles)."""
+    points = boundary_samples(domain)
+    circles = [(c.center, c.radius) for loop in domain.loops for c in loop
+               if isinstance(c, Arc) and c.is_full]
+    best = 0.0
+    if len(points):
+        d = points[:, None, :] - points[None, :, :]
+        best = float(np.sqrt((d ** 2).sum(-1).max()))
+    for centre, radius in circles:
+        best = max(best, 2 * radius)
+        if len(points):
+            best = max(best, float(np.hypot(*(points - centre).T).max()) + radius)
+    for (c1, r1) in circles:
+        for (c2, r2) in circles:
+            best = max(best, float(np.hypot(*(c1 - c2))) + r1 + r2)
+    return best
+
+
+def _key(value: float, scale: float) -> float:
+    return round(value / scale, KEY_DIGITS)
+
+
+def area_centroid(domain) -> np.ndarray:
+    """Centroid of the region (holes subtracted): curves as fine polygons sampled at fixed
+    parameters, full circles exactly.  Unlike the boundary's mean it sees where holes are."""
+    t = np.linspace(0.0, 1.0, SAMPLES_PER_CURVE + 1)[:-1]
+    area, moment = 0.0, np.zeros(2)
+    for loop in domain.loops:
+        if len(loop) == 1 and isinstance(loop[0], Arc) and loop[0].is_full:
+            c = loop[0]
+            signed = math.pi * c.radius ** 2 * (1.0 if c.sweep > 0 else -1.0)
+            area += signed
+            moment += signed * np.asarray(c.center, dtype=float)
+            continue
+        poly = np.concatenate([curve.point(t) for curve in loop])
+        x, y = poly[:, 0], poly[:, 1]
+        xn, yn = np.roll(x, -1), np.roll(y, -1)
+        cross = x * yn - xn * y
+        area += 0.5 * cross.sum()
+        moment += np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / 6.0
+    return moment / area
+
+
+def canonical_pose(domain) -> Pose:
+    points = boundary_samples(domain)
+    circles = [c for loop in domain.loops for c in loop if isinstance(c, Arc) and c.is_full]
+    center = area_centroid(domain)
+    scale = diameter(domain)
+    rotation = _rotation(domain, center, scale, points, circles)
+    angles = np.linspace(0.0, 2 * math.pi, SAMPLES_PER_CURVE, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])  # fixed in the turned frame
+    turned = [(points - center) @ rotation.T] + [
+        (np.asarray(c.center) - center) @ rotation.T + c.radius * ring for c in circles]
+    turned = np.concatenate(turned)
+    mirror = np.eye(2)
+    if _key(float((turned[:, 0] ** 3).mean()), scale ** 3) < 0:
+        mirror = np.diag([-1.0, 1.0])  # keeps the chosen edge on +x, the part above it
+    return Pose(center=center, scale=scale, matrix=mirror @ rotation)
+
+
+def _rotation(domain, center, scale, points, circles) -> np.ndarray:
+    """Turn the chosen straight edge (domain on its left) to +x.
+
+    The edge: the longest; ties go to the one farther from the centroid, then to the one
+    whose start is farther; without straight edges, the direction from the centroid to
+    the farthest sample (or to the first hole's centre) serves.
+    """
+    best_key, direction = None, None
+    for loop in domain.loops:
+        for curve in loop:
+            if not isinstance(curve, Line):
+                continue
+            mid = 0.5 * (curve.p0 + curve.p1)
+            key = (_key(curve.length, scale), _key(float(np.hypot(*(mid - center))), scale),
+                   _key(float(np.hypot(*(curve.p0 - center))), scale))
+            if best_key is None or key > best_key:
+                best_key, direction = key, curve.p1 - curve.p0
+    if direction is None:
+        if len(points):
+            far = np.hypot(*(points - center).T)
+            direction = points[int(np.argmax(np.round(far / scale, KEY_DIGITS)))] - center
+        elif len(circles) > 1:
+            direction = circles[1].center - center
+        else:
+            direction = np.array([1.0, 0.0])
+    angle = -math.atan2(direction[1], direction[0])
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s], [s, c]])
