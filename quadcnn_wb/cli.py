@@ -7,6 +7,7 @@ stderr starting with `error:` and no traceback; 1 only for a bug.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 
@@ -42,6 +43,7 @@ def _whole_number(minimum: int):
 
 
 _positive_int = _whole_number(8)  # node counts
+DEFAULT_TIME_LIMIT = 120.0  # seconds, for background, field and mesh
 _positive_count = _whole_number(1)
 
 
@@ -73,7 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "is installed, else numerical tracing)")
     ms.add_argument("--model", help="ONNX model for the cnn method")
     ms.add_argument("--size", type=_positive_float, help="target element size (default: the "
-                    "domain diagonal / 40)")
+                    "part's diameter / 40)")
     ms.set_defaults(run=_run_mesh)
 
     fam = commands.add_parser("families", help="list the shape families and their parameters")
@@ -117,6 +119,9 @@ def _stage_parser(commands, name, summary, nodes_help, output_help, png_help):
     sub.add_argument("--nodes", type=_positive_int, default=2048, help=nodes_help)
     sub.add_argument("-o", "--output", help=output_help)
     sub.add_argument("--png", help=png_help)
+    sub.add_argument("--time-limit", type=_positive_float, default=DEFAULT_TIME_LIMIT,
+                     help=f"give up (exit 2) after this many seconds (default "
+                     f"{DEFAULT_TIME_LIMIT:g}; a 2048-node run takes well under one)")
     return sub
 
 
@@ -182,13 +187,13 @@ def _streamline_source(args, domain):
     one and traces numerically otherwise; cnn insists on a model.
     """
     from .infer.cnn import cnn_streamlines
-    from .infer.models import model_for, user_model_folder
+    from .infer.models import AUTO_MIN_IOU, model_for, user_model_folder
 
     if args.method == "numerical" and not args.model:
         return None, "numerical"
     if args.model:
         return cnn_streamlines(args.model), "cnn"
-    entry = model_for(domain)
+    entry = model_for(domain, min_iou=AUTO_MIN_IOU if args.method == "auto" else 0.0)
     if entry is not None:
         return cnn_streamlines(entry.path), "cnn"
     if args.method == "cnn":
@@ -293,12 +298,39 @@ def _run_evaluate(args) -> None:
                    for k, v in metrics.items()))
 
 
+class TimeLimitError(RuntimeError):
+    """The run took longer than --time-limit."""
+
+
+def _run_with_time_limit(args) -> None:
+    """A hard ceiling on the whole run: no stage can keep the command line waiting.
+
+    The alarm interrupts whatever Python code runs (gmsh and the solvers return to
+    Python within milliseconds at these sizes); outputs are written atomically, so nothing
+    half-written is left behind."""
+    limit = getattr(args, "time_limit", None)
+    if not limit or not hasattr(signal, "setitimer"):
+        return args.run(args)
+
+    def give_up(signum, frame):
+        raise TimeLimitError(f"gave up after {limit:g} s (--time-limit); try fewer --nodes "
+                             "or a larger --size")
+
+    previous = signal.signal(signal.SIGALRM, give_up)
+    signal.setitimer(signal.ITIMER_REAL, limit)
+    try:
+        return args.run(args)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        args.run(args)
+        _run_with_time_limit(args)
     except (DomainError, BackgroundMeshError, FieldError, PartitionError, ModelError,
-            UsageError, OSError) as exc:
+            UsageError, TimeLimitError, OSError) as exc:
         message = " ".join(str(exc).split())
         print(f"error: {message}", file=sys.stderr)
         return 2

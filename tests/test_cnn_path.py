@@ -77,13 +77,24 @@ def test_auto_picks_a_user_model_of_the_same_topology(untrained, tmp_path, monke
     folder.mkdir()
     domain = load_domain(SHARED_EXAMPLES / "l_shape.json")
     model = untrained(topology_signature(domain))
-    for suffix in (".onnx", ".json"):
-        (folder / f"mine{suffix}").write_bytes(model.with_suffix(suffix).read_bytes())
+    meta = json.loads(model.with_suffix(".json").read_text())
+    for name, iou in (("mine", 0.9), ("weak", 0.3)):
+        (folder / f"{name}.onnx").write_bytes(model.read_bytes())
+        (folder / f"{name}.json").write_text(json.dumps(
+            {**meta, "metrics_test_split": {"iou": iou}}))
     (folder / "broken.onnx").write_bytes(b"not a model")
     (folder / "broken.json").write_text("{ not json")
     monkeypatch.setenv("QUADCNN_MODELS", str(folder))
-    entry = model_for(domain)
+    from quadcnn_wb.infer.models import AUTO_MIN_IOU
+
+    entry = model_for(domain, min_iou=AUTO_MIN_IOU)
     assert entry is not None and entry.origin == "user" and entry.path.name == "mine.onnx"
+    (folder / "mine.json").unlink()  # now only the weak one: cnn takes it, auto does not
+    assert model_for(domain).path.name == "weak.onnx"
+    assert model_for(domain, min_iou=AUTO_MIN_IOU) is None
+    result = run_cli("mesh", SHARED_EXAMPLES / "l_shape.json", "-o", tmp_path / "weak.json")
+    assert json.loads((tmp_path / "weak.json").read_text())["method"] == "numerical"
+    (folder / "mine.json").write_text(json.dumps({**meta, "metrics_test_split": {"iou": 0.9}}))
     assert all(e.path.name != "broken.onnx" for e in available_models())
     assert model_for(load_domain(SHARED_EXAMPLES / "plate_hole.json")) is None or \
         model_for(load_domain(SHARED_EXAMPLES / "plate_hole.json")).origin == "shipped"

@@ -163,7 +163,7 @@ def unit(value):
     """Round unit-scaled values so that a moved or rescaled copy of a part gives gmsh the
     very same numbers (not numbers a rounding error apart, which can flip a Delaunay
     decision and change the whole mesh)."""
-    return np.round(value, UNIT_DIGITS)
+    return np.round(value, UNIT_DIGITS) + 0.0  # + 0.0: no negative zeros either
 
 
 def _unit_loops(domain: Domain, pose: Pose):

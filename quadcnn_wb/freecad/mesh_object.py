@@ -152,9 +152,9 @@ def _learned_source(obj, domain):
     if obj.Model:
         obj.ModelEntry = "embedded"
         return cnn_streamlines(obj.Model, threads=preferences.threads())
-    from ..infer.models import model_for, user_model_folder
+    from ..infer.models import AUTO_MIN_IOU, model_for, user_model_folder
 
-    entry = model_for(domain)
+    entry = model_for(domain, min_iou=AUTO_MIN_IOU if obj.Method == "auto" else 0.0)
     if entry is not None:
         obj.ModelEntry = f"{entry.origin}: {entry.path.name}"
         return cnn_streamlines(entry.path, threads=preferences.threads())

@@ -18,6 +18,9 @@ from .predictor import ModelError, load_metadata
 from .signature import topology_signature
 
 SHIPPED_MODELS = Path(__file__).resolve().parents[2] / "resources" / "models"
+# `auto` only takes a model this good on its test split (foreground IoU): a weaker one
+# still gives a valid mesh through the numerical fallback, but slower than tracing alone.
+AUTO_MIN_IOU = 0.8
 
 
 @dataclass(frozen=True)
@@ -26,6 +29,7 @@ class ModelEntry:
     family: str
     topology: str
     origin: str  # "user" or "shipped"
+    test_iou: float = 0.0  # from its metadata (0 when not recorded)
 
 
 def user_model_folder() -> Path:
@@ -64,15 +68,17 @@ def available_models(folders=None) -> list[ModelEntry]:
             except ModelError:
                 continue
             if meta.get("topology"):
+                iou = float(meta.get("metrics_test_split", {}).get("iou", 0.0))
                 entries.append(ModelEntry(path, str(meta.get("family", path.stem)),
-                                          meta["topology"], origin))
+                                          meta["topology"], origin, iou))
     return entries
 
 
-def model_for(domain, folders=None) -> ModelEntry | None:
-    """The first model (user before shipped) trained on this domain's topology."""
+def model_for(domain, folders=None, min_iou: float = 0.0) -> ModelEntry | None:
+    """The first model (user before shipped) trained on this domain's topology, among
+    those whose recorded test IoU reaches min_iou (AUTO_MIN_IOU for the auto method)."""
     signature = topology_signature(domain)
     for entry in available_models(folders):
-        if entry.topology == signature:
+        if entry.topology == signature and entry.test_iou >= min_iou:
             return entry
     return None
