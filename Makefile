@@ -11,7 +11,8 @@ OUT := out
 export LANG := C.UTF-8
 export QTWEBENGINE_CHROMIUM_FLAGS := --no-sandbox
 
-.PHONY: help setup system-packages venv link demo test lint bench clean
+.PHONY: help setup system-packages venv link demo test lint bench learning-figures models \
+	robustness clean
 
 help:
 	@echo "make demo   - set up, then mesh a bundled example and write pictures to $(OUT)/"
@@ -19,6 +20,9 @@ help:
 	@echo "make setup  - install what is missing (Debian packages, $(VENV), FreeCAD Mod link)"
 	@echo "make bench  - print speed and quality figures (background, field, mesh vs gmsh,"
 	@echo "              onnxruntime inference, CalculiX plate-with-hole check)"
+	@echo "make learning-figures - Table 2 of the paper with our models, cnn vs numerical"
+	@echo "make models - regenerate the data sets and retrain the shipped models (hours)"
+	@echo "make robustness - the 500-shape random robustness campaign"
 
 setup: system-packages $(STAMP) link
 
@@ -56,8 +60,11 @@ demo: setup
 	    -o $(OUT)/four_hole_mesh.json --png $(OUT)/four_hole_mesh.png
 	$(PY) -m quadcnn_wb mesh resources/examples/four_hole.json --method numerical \
 	    -o $(OUT)/four_hole_mesh.inp
+	$(PY) -m quadcnn_wb mesh resources/examples/four_hole.json --method cnn \
+	    -o $(OUT)/four_hole_mesh_cnn.json --png $(OUT)/four_hole_mesh_cnn.png
 	QUADCNN_OUT=$(OUT) freecadcmd quadcnn_wb/freecad/demo.py
-	@echo "wrote $(OUT)/four_hole_{background,field,mesh}.png, their .json and four_hole_mesh.inp"
+	@echo "wrote $(OUT)/four_hole_{background,field,mesh,mesh_cnn}.png, their .json and"
+	@echo "four_hole_mesh.inp (mesh_cnn: streamlines from the shipped network, see 'fallback')"
 	@echo "and, from headless FreeCAD, $(OUT)/plate_design.FCStd (edited and regenerated),"
 	@echo "plate_design_mesh.inp and plate_design_mesh.png"
 
@@ -74,6 +81,27 @@ bench: setup
 	$(PY) -m quadcnn_wb.bench.mesh_vs_gmsh
 	$(PY) -m quadcnn_wb.bench.inference_speed
 	$(PY) -m quadcnn_wb.fem.plate_tension
+
+learning-figures: setup
+	$(PY) -m quadcnn_wb.bench.table2 --samples 400
+	$(PY) -m quadcnn_wb.bench.cnn_agreement --samples 40
+	$(PY) -m quadcnn_wb.bench.inference_speed
+
+# The exact commands behind resources/models (see docs/learning.md); needs the train extra.
+models: setup
+	@mkdir -p data
+	$(PY) -m quadcnn_wb dataset concave -n 2000 --seed 1 --workers 2 -o data/concave.npz
+	$(PY) -m quadcnn_wb dataset four_hole -n 2000 --seed 2 --workers 2 -o data/four_hole.npz
+	$(PY) -m quadcnn_wb dataset semicircle -n 1200 --seed 3 --workers 2 -o data/semicircle.npz
+	$(PY) -m quadcnn_wb train data/concave.npz -o resources/models/concave.onnx --recipe fast \
+	    --epochs 20 --patience 8 --minutes 100 --threads 1 --seed 0
+	$(PY) -m quadcnn_wb train data/four_hole.npz -o resources/models/four_hole.onnx \
+	    --recipe fast --epochs 20 --patience 8 --minutes 100 --threads 1 --seed 0
+	$(PY) -m quadcnn_wb train data/semicircle.npz -o resources/models/semicircle.onnx \
+	    --recipe fast --epochs 8 --patience 8 --minutes 60 --threads 1 --seed 0
+
+robustness: setup
+	$(PY) -m quadcnn_wb.bench.robustness -n 500 --seed 0
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache

@@ -60,7 +60,7 @@ def hausdorff_share(a_lines, b_lines, diagonal: float) -> float:
 
 def structure(result) -> tuple:
     p = result.partition
-    return (len(p.faces), len(p.edges), len(p.vertices)) if result.structured else ()
+    return (len(p.blocks), len(p.edges), len(p.vertices)) if result.structured else ()
 
 
 def compare(model: Path, samples: int, seed: int, nodes: int) -> dict:

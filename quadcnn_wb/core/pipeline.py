@@ -101,30 +101,21 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     else:
         lines = trace_streamlines(domain, background, field)
         timings["tracing"] = time.perf_counter() - clock
-    clock = time.perf_counter()
     problem = ""
     try:
         try:
-            cuts, partition = _partition(domain, background, field, lines)
+            cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
+                                                             size, smoothing, timings)
         except PartitionError:
             if method != "cnn":
                 raise
+            # The learned streamlines gave no valid block mesh: trace them all instead.
+            clock = time.perf_counter()
             lines = tuple(dataclasses.replace(line, fallback=True)
                           for line in trace_streamlines(domain, background, field))
-            cuts, partition = _partition(domain, background, field, lines)
-        timings["partition"] = time.perf_counter() - clock
-        clock = time.perf_counter()
-        counts = quantize(partition, size)
-        timings["quantization"] = time.perf_counter() - clock
-        clock = time.perf_counter()
-        mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
-        timings["quad_mesh"] = time.perf_counter() - clock
-        worst = scaled_jacobians(mesh.nodes, mesh.quads).min() if len(mesh.quads) else 0.0
-        if worst <= MIN_VALID_JACOBIAN:
-            raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
-                                 f"{worst:.3f})")
-        if not tiles_exactly(mesh.nodes, mesh.quads):
-            raise PartitionError("the blocks overlap (their quads fold over each other)")
+            timings["fallback_tracing"] = time.perf_counter() - clock
+            cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
+                                                             size, smoothing, timings)
     except PartitionError as exc:
         # Never leave a valid input without a mesh: gmsh's unstructured quads stand in.
         problem = f"no block structure ({exc}); unstructured all-quad mesh from gmsh"
@@ -142,6 +133,27 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
                       counts=counts, mesh=mesh, quality=quality, size=size, method=method,
                       fallback=fallback, timings=timings, structured=not problem,
                       problem=problem)
+
+
+def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings):
+    """Partition, segment counts and the block-structured mesh, checked; PartitionError
+    when any of them cannot be had from these streamlines."""
+    clock = time.perf_counter()
+    cuts, partition = _partition(domain, background, field, lines)
+    timings["partition"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    counts = quantize(partition, size)
+    timings["quantization"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
+    timings["quad_mesh"] = time.perf_counter() - clock
+    worst = scaled_jacobians(mesh.nodes, mesh.quads).min() if len(mesh.quads) else 0.0
+    if worst <= MIN_VALID_JACOBIAN:
+        raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
+                             f"{worst:.3f})")
+    if not tiles_exactly(mesh.nodes, mesh.quads):
+        raise PartitionError("the blocks overlap (their quads fold over each other)")
+    return cuts, partition, counts, mesh
 
 
 def tiles_exactly(nodes, quads) -> bool:
