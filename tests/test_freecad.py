@@ -179,3 +179,66 @@ def test_batch_macro_regenerates_a_folder(tmp_path):
     for name in ("first", "second"):
         assert (folder / f"{name}_QuadMesh.inp").stat().st_size > 1000
         assert (folder / f"{name}_QuadMesh.vtk").stat().st_size > 1000
+
+
+TRAIN_CHECK = """
+import json, os, time, traceback
+import FreeCAD, FreeCADGui
+from PySide import QtGui
+result = {}
+try:
+    FreeCADGui.activateWorkbench("QuadCNNWorkbench")
+    doc = FreeCAD.openDocument(%(design)r)
+    sketch = doc.getObject("Plate")
+    from quadcnn_wb.freecad.mesh_object import make_quad_mesh
+    mesh = make_quad_mesh(doc, sketch, Method="numerical")
+    doc.recompute()
+    from quadcnn_wb.freecad import train_dialog
+    from quadcnn_wb.freecad.design_variants import dimensions, make_variants
+    spread = {d.index: 0.2 for d in dimensions(sketch)}
+    domains, _ = make_variants(sketch, 4, spread)
+    work = %(work)r
+    variants = os.path.join(work, "variants.json")
+    with open(variants, "w") as handle:
+        json.dump({"name": sketch.Label, "domains": domains}, handle)
+    from pathlib import Path
+    run = train_dialog.TrainingRun(sketch, Path(variants), Path(work) / "model.onnx", 12, 1)
+    seen = []
+    started = time.time()
+    while train_dialog.TrainingRun.RUNNING and time.time() - started < 200:
+        QtGui.QApplication.processEvents()
+        seen.append(run.dialog.value())
+        time.sleep(0.05)
+    result["finished"] = not train_dialog.TrainingRun.RUNNING
+    result["run_error"] = run.error
+    result["progress_max"] = max(seen) if seen else -1
+    result["embedded"] = bool(mesh.Model)
+    folder = os.environ["QUADCNN_MODELS"]
+    result["saved"] = sorted(os.listdir(folder)) if os.path.isdir(folder) else []
+except Exception:
+    result["error"] = traceback.format_exc()
+with open(%(report)r, "w") as handle:
+    json.dump(result, handle)
+os._exit(0)
+"""
+
+
+def test_train_model_runs_in_a_process_and_installs_the_model(tmp_path):
+    report, work, models = tmp_path / "train.json", tmp_path / "work", tmp_path / "models"
+    work.mkdir()
+    design = tmp_path / "design.FCStd"
+    shutil.copyfile(REPO / "resources" / "examples" / "plate_design.FCStd", design)
+    script = tmp_path / "train_check.py"
+    script.write_text(TRAIN_CHECK % {"design": str(design), "work": str(work),
+                                     "report": str(report)})
+    result = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad",
+                             str(script)], capture_output=True, text=True, cwd=tmp_path,
+                            env={**FREECAD_ENV, "QUADCNN_MODELS": str(models)}, timeout=400)
+    assert report.is_file(), (result.stdout + result.stderr)[-3000:]
+    data = json.loads(report.read_text())
+    assert "error" not in data, data.get("error")
+    assert data["finished"] and not data["run_error"], data["run_error"]
+    assert data["progress_max"] > 300  # the bar moved with the process's progress lines
+    assert data["saved"] == ["design_Plate.json", "design_Plate.onnx"]
+    assert data["embedded"]
+    assert not work.exists()  # the scratch folder is cleaned up

@@ -116,9 +116,13 @@ class TrainingRun(QtCore.QObject):
             elif code != 0 or not self.model_path.is_file():
                 lines = [s for s in stderr.splitlines() if s.startswith("error:")]
                 message = lines[-1] if lines else (stderr.strip().splitlines() or ["failed"])[-1]
+                self.error = message
                 FreeCAD.Console.PrintError(f"QuadCNN: training failed: {message}\n")
-                QtGui.QMessageBox.warning(FreeCADGui.getMainWindow(), "QuadCNN training",
-                                          message)
+                box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "QuadCNN training",
+                                        message, parent=FreeCADGui.getMainWindow())
+                box.setModal(False)  # tell, but never hold the GUI
+                box.show()
+                self.message_box = box
             else:
                 self.install()
         finally:

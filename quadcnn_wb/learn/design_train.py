@@ -41,8 +41,9 @@ def run(variants_path, out, samples: int, epochs: int, seed: int, minutes, worke
                              progress=lambda d, n: say(GENERATION_SHARE * d / n,
                                                        f"sample {d}/{n}"))
     if len(data) < 10:
-        raise ValueError(f"only {len(data)} usable samples of {samples} (dropped: "
-                         f"{dict(dropped)}); narrow the ranges")
+        hint = "narrow the ranges" if dropped else "ask for more samples"
+        raise ValueError(f"only {len(data)} usable samples of {samples}, at least 10 needed "
+                         f"(dropped: {dict(dropped) or 'none'}); {hint}")
     out = Path(out)
     data_path = out.with_suffix(".npz")
     topology = topology_signature(design)
