@@ -50,8 +50,9 @@ def run_one(seed: int, index: int) -> dict:
     def on_boundary(p):
         return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol for c in curves)
 
+    arcs = [(np.asarray(c.center), c.radius) for c in curves if hasattr(c, "radius")]
     try:
-        check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary)
+        check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs)
     except MeshDefect as exc:
         return {**row, "outcome": "invalid mesh", "reason": str(exc)}
     outcome = "valid, block-structured" if result.structured else "valid, gmsh stand-in"

@@ -153,7 +153,20 @@ def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings)
                              f"{worst:.3f})")
     if not tiles_exactly(mesh.nodes, mesh.quads):
         raise PartitionError("the blocks overlap (their quads fold over each other)")
+    if not free_edges_on_boundary(mesh.quads, mesh.boundary):
+        raise PartitionError("the blocks leave a gap inside the domain")
     return cuts, partition, counts, mesh
+
+
+def free_edges_on_boundary(quads, boundary) -> bool:
+    """Every edge used by one quad only joins two boundary nodes: no gap inside.
+
+    (A gap's own edges enclose a negative area, so tiles_exactly cannot see it.)"""
+    directed = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    key = np.sort(directed, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    free = key[counts[inverse.ravel()] == 1]
+    return bool(boundary[free].all())
 
 
 def tiles_exactly(nodes, quads) -> bool:
