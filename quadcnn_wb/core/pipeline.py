@@ -93,7 +93,9 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
     timings = {}
-    background, field = background_and_field(domain, nodes, timings)
+    # The cnn path needs the node count its network was trained for; tracing does not.
+    background, field = background_and_field(domain, nodes, timings,
+                                             strict=method == "cnn")
     clock = time.perf_counter()
     if method == "cnn":
         lines, _ = learned_streamlines(domain, background, field)

@@ -42,11 +42,11 @@ class Reference:
 
 
 def background_and_field(domain: Domain, nodes: int, timings: dict,
-                         mesh: BackgroundMesh | None = None):
+                         mesh: BackgroundMesh | None = None, strict: bool = True):
     """The stages every path shares: background mesh (unless given) and cross field."""
     clock = time.perf_counter()
     if mesh is None:
-        mesh = background_mesh(domain, nodes=nodes)
+        mesh = background_mesh(domain, nodes=nodes, strict=strict)
         timings["background"] = time.perf_counter() - clock
         clock = time.perf_counter()
     field = compute_frame_field(mesh)
