@@ -101,6 +101,8 @@ def build_parser() -> argparse.ArgumentParser:
     tr.add_argument("--patience", type=_positive_count, default=6)
     tr.add_argument("--minutes", type=_positive_float,
                     help="stop after this wall time, keeping the best epoch so far")
+    tr.add_argument("--init", help="start from the best weights of a checkpoint (.ckpt.pt "
+                    "written beside a model by an earlier run of the same recipe)")
     tr.set_defaults(run=_run_train)
 
     ev = commands.add_parser("evaluate", help="label metrics of a model on a data set")
@@ -268,7 +270,8 @@ def _run_train(args) -> None:
     out = _check_output(args.output, {".onnx"})
     try:
         meta = train(args.data, out, epochs=args.epochs, seed=args.seed, recipe=args.recipe,
-                     threads=args.threads, patience=args.patience, minutes=args.minutes)
+                     threads=args.threads, patience=args.patience, minutes=args.minutes,
+                     init=args.init)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     m = meta["metrics_test_split"]

@@ -111,6 +111,22 @@ def tiny(tmp_path_factory):
     return data, model, meta, samples
 
 
+def test_training_goes_on_from_a_checkpoint(tiny, tmp_path):
+    data, model, _, _ = tiny
+    checkpoint = model.with_suffix(".ckpt.pt")
+    assert checkpoint.is_file()
+    meta = train(data, tmp_path / "more.onnx", epochs=1, seed=0, recipe="fast", threads=2,
+                 progress=False, init=checkpoint)
+    assert meta["recipe"]["init"] == checkpoint.name
+    with pytest.raises(ValueError, match="another architecture"):
+        train(data, tmp_path / "paper.onnx", epochs=1, recipe="paper", progress=False,
+              init=checkpoint)
+    (tmp_path / "junk.ckpt.pt").write_bytes(b"junk")
+    with pytest.raises(ValueError, match="not a training checkpoint"):
+        train(data, tmp_path / "junk.onnx", epochs=1, recipe="fast", progress=False,
+              init=tmp_path / "junk.ckpt.pt")
+
+
 def test_data_set_round_trip(tiny):
     data, _, _, samples = tiny
     back, meta = load_dataset(data)

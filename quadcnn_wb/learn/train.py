@@ -127,13 +127,15 @@ def best_threshold(probabilities, samples, indices) -> float:
 def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "paper",
           threads: int = 2, patience: int = 6, progress: bool = True,
           minutes: float | None = None, monitor: int = 100, report=None,
-          meta_extra: dict | None = None) -> dict:
+          meta_extra: dict | None = None, init=None) -> dict:
     """Train, keep the best epoch by validation IoU, export ONNX and its metadata.
 
     `minutes` bounds the wall time (the epoch under way stops, the best model so far is
     kept); `monitor` validation samples choose the best epoch, the whole validation split
     gives the reported metrics and the decision threshold.  `report(fraction, text)`, when
-    given, hears about every step (the FreeCAD training dialog's progress bar).
+    given, hears about every step (the FreeCAD training dialog's progress bar).  `init`, a
+    checkpoint (.ckpt.pt) of the same recipe, starts from its best weights: training can go
+    on across sessions (with a fresh schedule).
     """
     if recipe not in RECIPES:
         raise ValueError(f"unknown recipe {recipe!r} (known: {', '.join(RECIPES)})")
@@ -155,6 +157,18 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
                else None)
     architecture = settings.get("model", {})
     net = QuadCNN(**architecture)
+    if init is not None:
+        try:
+            start = torch.load(init, map_location="cpu", weights_only=False)
+        except FileNotFoundError:
+            raise ValueError(f"{init}: no such checkpoint") from None
+        except Exception as exc:
+            raise ValueError(f"{init}: not a training checkpoint ({type(exc).__name__})") \
+                from None
+        if start.get("architecture", {}) != architecture:
+            raise ValueError(f"{init}: a checkpoint of another architecture "
+                             f"({start.get('architecture')}), not recipe {recipe!r}'s")
+        net.load_state_dict(start["best_state"] or start["state"])
     if settings["optimizer"] == "sgd":
         opt = torch.optim.SGD(net.parameters(), lr=settings["lr"], momentum=settings["momentum"])
     else:
@@ -222,6 +236,7 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
         "recipe": {"name": recipe, **settings, "pos_weight_used": pos_weight,
                    "epochs_run": len(history),
                    "best_epoch": best_epoch, "seed": seed, "minutes": minutes,
+                   "init": Path(init).name if init is not None else None,
                    "stopped_by_time": out_of_time},
         "data": {"path": Path(data_path).name, "seed": meta.get("seed"),
                  "nodes": meta.get("nodes"), "samples": len(samples),
