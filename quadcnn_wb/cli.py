@@ -183,28 +183,17 @@ def _run_field(args) -> None:
 
 
 def _streamline_source(args, domain):
-    """(learned streamline source or None, method name) for --method and --model.
-
-    auto takes a user or shipped model trained on this domain's topology when there is
-    one and traces numerically otherwise; cnn insists on a model.
-    """
+    """(learned streamline source or None, method name) for --method and --model."""
     from .infer.cnn import cnn_streamlines
-    from .infer.models import AUTO_MIN_IOU, model_for, user_model_folder
+    from .infer.models import model_for_method
 
-    if args.method == "numerical" and not args.model:
-        return None, "numerical"
     if args.model:
         return cnn_streamlines(args.model), "cnn"
-    entry = model_for(domain, min_iou=AUTO_MIN_IOU if args.method == "auto" else 0.0)
-    if entry is not None:
-        return cnn_streamlines(entry.path), "cnn"
-    if args.method == "cnn":
-        from .infer.signature import topology_signature
-
-        raise UsageError(f"no model for this domain's topology {topology_signature(domain)}: "
-                         f"train one ('quadcnn dataset' + 'quadcnn train'), put it in "
-                         f"{user_model_folder()} or pass --model MODEL.onnx")
-    return None, "numerical"
+    entry = model_for_method(domain, args.method, "train one ('quadcnn dataset' + 'quadcnn "
+                             "train') or pass --model MODEL.onnx")
+    if entry is None:
+        return None, "numerical"
+    return cnn_streamlines(entry.path), "cnn"
 
 
 def _run_mesh(args) -> None:

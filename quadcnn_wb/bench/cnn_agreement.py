@@ -25,7 +25,7 @@ from ..core.domain import domain_from_json
 from ..core.pipeline import mesh_domain
 from ..core.transform import similarity, transform_domain_json
 from ..infer.cnn import cnn_streamlines
-from ..infer.models import SHIPPED_MODELS
+from ..infer.models import model_paths
 from ..infer.predictor import Predictor
 from ..learn.families import family
 
@@ -65,7 +65,7 @@ def structure(result) -> tuple:
 
 def compare(model: Path, samples: int, seed: int, nodes: int) -> dict:
     name = Predictor(model).metadata["family"]
-    source = cnn_streamlines(model, threads=1)
+    source = cnn_streamlines(model, threads=1)  # its own session, created once
     rng = np.random.default_rng(seed)
     rows = []
     for _ in range(samples):
@@ -94,18 +94,18 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=9100)
     parser.add_argument("--nodes", type=int, default=2048)
     args = parser.parse_args(argv)
-    models = [Path(m) for m in args.models] or sorted(SHIPPED_MODELS.glob("*.onnx"))
+    models = model_paths(args.models)
     print("| family | samples | no fallback | same blocks | Hausdorff median / worst "
           "(% diag) | valid cnn / numerical | cnn time | tracing time | speed-up |")
     print("|---|---|---|---|---|---|---|---|---|")
     for model in models:
-        rows = compare(model, args.samples, args.seed, args.nodes)["rows"]
+        compared = compare(model, args.samples, args.seed, args.nodes)
+        name, rows = compared["family"], compared["rows"]
         share = {k: np.mean([r[k] for r in rows]) for k in
                  ("no_fallback", "same_structure", "valid_cnn", "valid_numerical")}
         h = np.array([r["hausdorff"] for r in rows]) * 100
         t_cnn = float(np.median([r["t_cnn"] for r in rows]))
         t_num = float(np.median([r["t_numerical"] for r in rows]))
-        name = Predictor(model).metadata["family"]
         print(f"| {name} | {len(rows)} | {share['no_fallback']:.0%} | "
               f"{share['same_structure']:.0%} | {np.median(h):.2f} / {h.max():.2f} | "
               f"{share['valid_cnn']:.0%} / {share['valid_numerical']:.0%} | "

@@ -17,10 +17,9 @@ from pathlib import Path
 from ..core.domain import load_domain
 from ..core.reference import numerical_reference
 from ..infer.encoding import encode
+from ..infer.models import model_paths
 from ..infer.predictor import Predictor
 from .common import EXAMPLES
-
-MODELS = Path(__file__).resolve().parents[2] / "resources" / "models"
 
 
 def main(argv=None) -> int:
@@ -28,7 +27,7 @@ def main(argv=None) -> int:
     parser.add_argument("models", nargs="*")
     parser.add_argument("--repeat", type=int, default=20)
     args = parser.parse_args(argv)
-    models = [Path(m) for m in args.models] or sorted(MODELS.glob("*.onnx"))
+    models = model_paths(args.models)
     if not models:
         import torch
 

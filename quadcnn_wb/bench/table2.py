@@ -9,12 +9,11 @@ reference, and compared with the model's prediction (DESIGN.md metric definition
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from ..infer.metrics import Confusion
+from ..infer.models import model_paths
 from ..infer.predictor import Predictor
 from ..learn.dataset import generate
-from .inference_speed import MODELS
 
 PAPER = {"concave": (0.852, 0.981), "four_hole": (0.821, 0.965)}
 
@@ -26,7 +25,7 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=9001)
     parser.add_argument("--workers", type=int, default=None)
     args = parser.parse_args(argv)
-    models = [Path(m) for m in args.models] or sorted(MODELS.glob("*.onnx"))
+    models = model_paths(args.models)
     print("| topology | data size | IoU (paper) | accuracy (paper) | IoU (ours) | accuracy (ours) "
           "| mIoU | all-zeros accuracy | test samples |")
     print("|---|---|---|---|---|---|---|---|---|")

@@ -152,20 +152,15 @@ def _learned_source(obj, domain):
     if obj.Model:
         obj.ModelEntry = "embedded"
         return cnn_streamlines(obj.Model, threads=preferences.threads())
-    from ..infer.models import AUTO_MIN_IOU, model_for, user_model_folder
+    from ..infer.models import model_for_method
 
-    entry = model_for(domain, min_iou=AUTO_MIN_IOU if obj.Method == "auto" else 0.0)
-    if entry is not None:
-        obj.ModelEntry = f"{entry.origin}: {entry.path.name}"
-        return cnn_streamlines(entry.path, threads=preferences.threads())
     obj.ModelEntry = ""
-    if obj.Method == "cnn":
-        from ..infer.signature import topology_signature
-
-        raise ValueError(f"no model for this shape's topology {topology_signature(domain)}: "
-                         f"embed one in Model, put one in {user_model_folder()}, or train "
-                         f"one (QuadCNN_TrainModel)")
-    return None
+    entry = model_for_method(domain, obj.Method, "embed one in Model, or train one "
+                             "(QuadCNN_TrainModel)")
+    if entry is None:
+        return None
+    obj.ModelEntry = f"{entry.origin}: {entry.path.name}"
+    return cnn_streamlines(entry.path, threads=preferences.threads())
 
 
 def _source_of(obj):

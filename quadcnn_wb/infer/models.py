@@ -74,6 +74,11 @@ def available_models(folders=None) -> list[ModelEntry]:
     return entries
 
 
+def model_paths(given) -> list[Path]:
+    """The model files a benchmark was given, or else every shipped one."""
+    return [Path(m) for m in given] or sorted(SHIPPED_MODELS.glob("*.onnx"))
+
+
 def model_for(domain, folders=None, min_iou: float = 0.0) -> ModelEntry | None:
     """The first model (user before shipped) trained on this domain's topology, among
     those whose recorded test IoU reaches min_iou (AUTO_MIN_IOU for the auto method)."""
@@ -82,3 +87,19 @@ def model_for(domain, folders=None, min_iou: float = 0.0) -> ModelEntry | None:
         if entry.topology == signature and entry.test_iou >= min_iou:
             return entry
     return None
+
+
+def model_for_method(domain, method: str, how_to_get_one: str) -> ModelEntry | None:
+    """The model the auto or cnn method takes for this domain (None: trace numerically).
+
+    auto settles for numerical tracing when no model reaches AUTO_MIN_IOU; cnn takes any
+    model of the topology and, without one, raises a ModelError saying where to put one
+    and `how_to_get_one` (the command line and FreeCAD offer different ways).
+    """
+    if method == "numerical":
+        return None
+    entry = model_for(domain, min_iou=AUTO_MIN_IOU if method == "auto" else 0.0)
+    if entry is None and method == "cnn":
+        raise ModelError(f"no model for this domain's topology {topology_signature(domain)}: "
+                         f"put one in {user_model_folder()} or {how_to_get_one}")
+    return entry
