@@ -96,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "goes beside it (.json)")
     tr.add_argument("--epochs", type=_positive_count, default=30)
     tr.add_argument("--seed", type=int, default=0)
-    tr.add_argument("--recipe", choices=["paper", "fast"], default="paper")
+    tr.add_argument("--recipe", choices=["paper", "fast", "rays"], default="paper")
     tr.add_argument("--threads", type=_positive_count, default=2)
     tr.add_argument("--patience", type=_positive_count, default=6)
     tr.add_argument("--minutes", type=_positive_float,

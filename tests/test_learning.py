@@ -3,6 +3,7 @@ a tiny end-to-end run (a few samples, one epoch) — CI never trains a full mode
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -44,6 +45,7 @@ def test_samples_are_deterministic_and_normalised():
     radius = np.hypot(a.x[:, 0], a.x[:, 1])
     assert 0.3 < radius.max() <= 0.5 + 1e-6  # inside the unit-diagonal box's circle
     assert np.allclose(np.hypot(a.x[:, 2], a.x[:, 3]), 1.0, atol=1e-6)
+    assert a.x.shape[1] == 8 and np.all((a.x[:, 4:] >= 0) & (a.x[:, 4:] <= 1))
     angle = np.arctan2(a.x[:, 3], a.x[:, 2])
     assert np.all(angle > -np.pi / 4 - 1e-6) and np.all(angle <= np.pi / 4 + 1e-6)
     assert 0 < a.y.mean() < 0.2 and set(np.unique(a.y)) == {0, 1}
@@ -54,6 +56,19 @@ def _same_up_to_centre_and_scale(a, b):
     scale = np.linalg.norm(da) / np.linalg.norm(db)
     return np.allclose(db * scale, da, atol=1e-5) and np.allclose(a[:, 2:], b[:, 2:],
                                                                   atol=1e-5)
+
+
+def test_encoding_carries_the_hints_of_v1_and_v2_with_their_labels():
+    rng = np.random.default_rng(2)
+    nodes = rng.uniform(size=(60, 2)) * [0.5, 1.0]  # tall: the settled pose is a quarter turn
+    theta = rng.uniform(-0.7, 0.7, size=60)
+    labels = rng.integers(0, 2, size=(60, 2))
+    hints = np.column_stack([labels, rng.random((60, 2))]).astype(float)
+    x, swapped = encode(nodes, theta, hints)
+    assert x.shape == (60, 8) and swapped.any()
+    assert np.array_equal(x[:, 4:6], swap_labels(labels, swapped))  # paired as labels are
+    assert np.allclose(x[:, 6:], hints[:, 2:], atol=1e-6)  # per-node values stay
+    assert np.allclose(x[:, :4], encode(nodes, theta)[0])
 
 
 def test_encoding_ignores_placement_scale_rotation_and_mirror():
@@ -127,6 +142,22 @@ def test_training_goes_on_from_a_checkpoint(tiny, tmp_path):
               init=tmp_path / "junk.ckpt.pt")
 
 
+def test_rays_recipe_reads_the_hints(tiny, tmp_path):
+    data, _, _, samples = tiny
+    model = tmp_path / "rays.onnx"
+    meta = train(data, model, epochs=1, seed=0, recipe="rays", threads=2, progress=False)
+    assert meta["input_shape"] == ["batch", "points", 8] and "rays:" in meta["input"]
+    predictor = Predictor(model)
+    assert predictor.inputs == 8
+    assert predictor.probabilities(samples[0].x).shape == (len(samples[0].x), 2)
+    with pytest.raises(ModelError, match="takes 8 input columns"):
+        predictor.probabilities(samples[0].x[:, :4])
+    old = tmp_path / "old.npz"  # a data set from before the hints: four columns
+    save_dataset(old, [dataclasses.replace(s, x=s.x[:, :4]) for s in samples], {})
+    with pytest.raises(ValueError, match="has 4 input columns, the model takes 8"):
+        train(old, tmp_path / "no.onnx", epochs=1, recipe="rays", progress=False)
+
+
 def test_data_set_round_trip(tiny):
     data, _, _, samples = tiny
     back, meta = load_dataset(data)
@@ -149,8 +180,9 @@ def test_training_writes_model_and_metadata(tiny):
                                                 "recall", "zero_baseline_accuracy", "samples"}
 
 
-@pytest.mark.parametrize("architecture", [{}, RECIPES["fast"]["model"]],
-                         ids=["table1", "fast"])
+@pytest.mark.parametrize("architecture", [{}, RECIPES["fast"]["model"],
+                                          RECIPES["rays"]["model"]],
+                         ids=["table1", "fast", "rays"])
 def test_onnx_matches_torch(tiny, tmp_path, architecture):
     _, _, _, samples = tiny
     torch.manual_seed(1)
@@ -161,8 +193,9 @@ def test_onnx_matches_torch(tiny, tmp_path, architecture):
     agree = total = 0
     for sample in samples:
         with torch.no_grad():
-            ref = torch.sigmoid(net(torch.from_numpy(sample.x[None])))[0].numpy()
-        got = predictor.probabilities(sample.x)
+            x = torch.from_numpy(np.ascontiguousarray(sample.x[None, :, :net.inputs]))
+            ref = torch.sigmoid(net(x))[0].numpy()
+        got = predictor.probabilities(sample.x)  # reads the columns it takes
         assert np.allclose(got, ref, atol=1e-4)
         agree += int(np.sum((got >= 0.5) == (ref >= 0.5)))
         total += ref.size

@@ -41,7 +41,6 @@ def labelled_segments(nodes, theta, labels, arm: float):
 def compute(domain, nodes: int = 2048):
     """(reference, labels or None, model entry or None) for the shape."""
     from ..core.reference import numerical_reference
-    from ..infer.encoding import encode, swap_labels
     from ..infer.models import model_for
     from ..infer.predictor import Predictor
 
@@ -49,8 +48,7 @@ def compute(domain, nodes: int = 2048):
     entry = model_for(domain)
     labels = None
     if entry is not None:
-        x, swapped = encode(ref.mesh.nodes, ref.field.theta)
-        labels = swap_labels(Predictor(entry.path).labels(x), swapped)
+        labels = Predictor(entry.path).field_labels(ref.mesh, ref.field)
     return ref, labels, entry
 
 

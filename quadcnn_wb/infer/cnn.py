@@ -7,7 +7,6 @@ signature in its metadata must match), with a clear message.
 
 from __future__ import annotations
 
-from .encoding import encode, swap_labels
 from .predictor import ModelError, Predictor
 from .reconstruct import reconstruct_streamlines
 from .signature import topology_signature
@@ -24,8 +23,7 @@ def cnn_streamlines(model_path, threads: int = 1):
             raise ModelError(f"{predictor.path.name} was trained for topology {expected} "
                              f"({predictor.metadata.get('family', '?')}); this domain is "
                              f"{actual}")
-        x, swapped = encode(background.nodes, field.theta)
-        labels = swap_labels(predictor.labels(x), swapped)
+        labels = predictor.field_labels(background, field)
         return reconstruct_streamlines(domain, background, field, labels)
 
     return source

@@ -8,6 +8,10 @@ gives (up to quarter turns) the same input, which the network then need not lear
 the cross direction in (-45°, 45°] after that turn (v2 is v1 turned by 90°, so it adds
 nothing).  The two outputs are the labels of v1 and v2 of the *encoded* frames: where the
 turn made the other vector v1, `swapped` says so and the labels trade places.
+
+Optional per-node hints (infer.rays, the "rays" recipe) follow as further columns; they
+are distances, the same in any pose, except that the first two belong to v1 and v2 and
+trade places with them.
 """
 
 from __future__ import annotations
@@ -28,8 +32,9 @@ def canonical_angle(angle: np.ndarray) -> np.ndarray:
     return -((-np.asarray(angle) + np.pi / 4) % (np.pi / 2) - np.pi / 4)
 
 
-def encode(nodes: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(N, 4) float32 network input, and (N,) bool: v1 and v2 traded places."""
+def encode(nodes: np.ndarray, theta: np.ndarray,
+           hints: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 4 + hints) float32 network input, and (N,) bool: v1 and v2 traded places."""
     xy = normalise_positions(nodes)
     theta = canonical_angle(theta)
     turn = float(np.angle(np.mean(np.exp(4j * theta)))) / 4.0
@@ -39,7 +44,10 @@ def encode(nodes: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray
     t = canonical_angle(turned)
     swapped = np.abs(((turned - t) + np.pi / 2) % np.pi - np.pi / 2) > np.pi / 4
     settled, quarter = settle(np.column_stack([xy, np.cos(t), np.sin(t)]))
-    return settled.astype(np.float32), swapped ^ quarter
+    swapped = swapped ^ quarter
+    if hints is not None:
+        settled = np.column_stack([settled, swap_labels(hints, swapped)])
+    return settled.astype(np.float32), swapped
 
 
 def settle(x: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -67,7 +75,22 @@ def settle(x: np.ndarray) -> tuple[np.ndarray, bool]:
 
 
 def swap_labels(labels: np.ndarray, swapped: np.ndarray) -> np.ndarray:
-    """Labels between original (v1, v2) order and encoded order (its own inverse)."""
+    """Labels between original (v1, v2) order and encoded order (its own inverse).
+
+    Only the first two columns (v1, v2) trade places; further columns stay.
+    """
     out = np.array(labels, copy=True)
-    out[swapped] = out[swapped][:, ::-1]
+    out[swapped, :2] = out[swapped][:, 1::-1]
     return out
+
+
+def model_input(mesh, field, width: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """encode() for a background mesh and its field, with the ray hints when the model
+    takes 4 + 4 columns."""
+    hints = None
+    if width > 4:
+        from .rays import field_rays, ray_features
+
+        hints = ray_features(mesh.nodes, mesh.triangles, field.theta, field_rays(field),
+                             mesh.element_size)
+    return encode(mesh.nodes, field.theta, hints)

@@ -7,7 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .encoding import model_input, swap_labels
+
 DEFAULT_THRESHOLD = 0.5
+INPUT_WIDTHS = (4, 8)  # the paper's (x, y, v1x, v1y); with the four ray hints
 
 
 class ModelError(ValueError):
@@ -32,20 +35,33 @@ class Predictor:
             raise ModelError(f"{self.path}: not a readable ONNX model "
                              f"({str(exc).splitlines()[0][:200]})") from None
         inputs = self.session.get_inputs()
-        if len(inputs) != 1 or inputs[0].shape[-1] != 4:
+        if len(inputs) != 1 or inputs[0].shape[-1] not in INPUT_WIDTHS:
             raise ModelError(f"{self.path}: expects {[i.shape for i in inputs]}, not the "
-                             "QuadCNN input [batch, points, 4]")
+                             "QuadCNN input [batch, points, 4] (or 8 with the ray hints)")
         self.input_name = inputs[0].name
+        self.inputs = int(inputs[0].shape[-1])
         self.metadata = load_metadata(self.path)
         self.threshold = float(self.metadata.get("threshold", DEFAULT_THRESHOLD))
 
     def probabilities(self, x: np.ndarray) -> np.ndarray:
-        """(N, 4) encoded points -> (N, 2) probabilities of label 1 for v1 and v2."""
-        batch = np.asarray(x, dtype=np.float32)[None]
+        """(N, ≥ inputs) encoded points -> (N, 2) probabilities of label 1 for v1 and v2.
+
+        Columns past the model's width are left out (a data set carries the hints
+        whether the model reads them or not)."""
+        x = np.asarray(x, dtype=np.float32)
+        if x.shape[-1] < self.inputs:
+            raise ModelError(f"{self.path.name} takes {self.inputs} input columns, the data "
+                             f"has {x.shape[-1]} (regenerate it with 'quadcnn dataset')")
+        batch = np.ascontiguousarray(x[None, :, :self.inputs])
         return self.session.run(None, {self.input_name: batch})[0][0]
 
     def labels(self, x: np.ndarray) -> np.ndarray:
         return (self.probabilities(x) >= self.threshold).astype(np.uint8)
+
+    def field_labels(self, mesh, field) -> np.ndarray:
+        """(N, 2) labels of the field's own (v1, v2): encoded, predicted, put back."""
+        x, swapped = model_input(mesh, field, self.inputs)
+        return swap_labels(self.labels(x), swapped)
 
 
 def metadata_path(model_path) -> Path:

@@ -44,7 +44,7 @@ def smooth_deformation(nodes, theta, labels, rng: np.random.Generator):
     """Bend a sample by a smooth random displacement; frames follow the Jacobian.
 
     A frame vector turned past ±45° changes which of the two is v1, so the labels swap
-    with it.
+    with it: `labels` holds pairs of columns (a value for v1, one for v2), each pair swaps.
     """
     size = float(np.hypot(*np.ptp(nodes, axis=0)))
     k = rng.uniform(1.0, 3.0, size=2) * 2 * np.pi / size
@@ -62,5 +62,6 @@ def smooth_deformation(nodes, theta, labels, rng: np.random.Generator):
     new_theta = canonical_angle(angle)
     turned = np.abs(((angle - new_theta) + np.pi / 2) % np.pi - np.pi / 2) > np.pi / 4
     labels = labels.copy()
-    labels[turned] = labels[turned][:, ::-1]
+    pairs = labels[turned].reshape(int(turned.sum()), labels.shape[1] // 2, 2)
+    labels[turned] = pairs[:, :, ::-1].reshape(int(turned.sum()), labels.shape[1])
     return out, new_theta, labels

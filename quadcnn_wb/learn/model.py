@@ -23,7 +23,8 @@ How the inconsistencies of Table 1 are resolved here:
 Options beyond Table 1 (all off by default, so QuadCNN() is the paper's network; the
 "fast" training recipe turns them on, see learn.train): Fourier features of the
 positions, keypoint pooling (soft-argmax locations the head sees offsets to), a mean-pooled
-half of the global feature, a dynamic graph for stages 2 and 3 (DGCNN), lighter widths.
+half of the global feature, a dynamic graph for stages 2 and 3 (DGCNN), lighter widths,
+and `inputs=8`: the four ray hints of infer.rays after the paper's four columns.
 kNN uses topk on minus the squared distance from batched matrix products (no cdist, no
 Python loop over points), so any number of points N works, in training and in ONNX.
 """
@@ -111,14 +112,16 @@ def keypoint_offsets(scores: torch.Tensor, pos: torch.Tensor) -> torch.Tensor:
 class QuadCNN(nn.Module):
     def __init__(self, k: int = K_NEIGHBOURS, widths=STAGE_WIDTHS, dropout: float = 0.5,
                  dynamic: bool = False, octaves: int = 0, global_width: int = GLOBAL_WIDTH,
-                 head=(256, 256, 128), mean_pool: bool = False, keypoints: int = 0):
+                 head=(256, 256, 128), mean_pool: bool = False, keypoints: int = 0,
+                 inputs: int = 4):
         super().__init__()
         self.k = k
+        self.inputs = inputs
         self.dynamic = dynamic
         self.octaves = octaves
         self.edge = nn.ModuleList()
         self.point = nn.ModuleList()
-        cin = 6 + 4 * octaves
+        cin = inputs + 2 + 4 * octaves
         for w in widths:
             self.edge.append(EdgeConv(cin, w))
             self.point.append(_pointwise(cin, w))
@@ -140,7 +143,7 @@ class QuadCNN(nn.Module):
             nn.Conv1d(h3, 2, 1))
 
     def forward(self, x: torch.Tensor, idx: torch.Tensor | None = None) -> torch.Tensor:
-        """(B, N, 4) points -> (B, N, 2) logits."""
+        """(B, N, inputs) points -> (B, N, 2) logits."""
         if idx is None:
             with torch.no_grad():
                 idx = knn(x[..., :2], self.k)

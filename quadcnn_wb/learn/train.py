@@ -7,6 +7,11 @@ Recipes:
   AdamW (1e-3, one-cycle schedule), and a lighter network (global feature 256, head
   128-128-64, dropout 0.1, Fourier features of the positions): a third of the cost per
   step, so three times the steps in a CPU session, which is what decides here.
+- "rays": the fast recipe's optimiser on a smaller network that also reads the ray hints
+  (infer.rays: where coarse field-following rays from the singular points run).  The
+  hints place the bands; the network learns where they are off (curving streamlines,
+  rays that end early, the exact crossed-triangle rule).  No ridge targets: the hints
+  already tell every point which way the band lies.
 80/20 split by the seed; the model with the best validation IoU is kept (early stop after
 `patience` epochs without improvement), checkpointed every epoch, exported to ONNX (opset
 17, dynamic batch and point count) with a metadata JSON beside it.
@@ -14,6 +19,7 @@ Recipes:
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import sys
 import time
@@ -26,6 +32,7 @@ import torch
 from ..core.atomic import write_atomic, write_json_atomic
 from ..infer.encoding import ENCODING
 from ..infer.metrics import Confusion
+from ..infer.rays import RAY_ENCODING
 from .dataset import load_dataset
 from .model import QuadCNN, knn
 
@@ -36,6 +43,10 @@ RECIPES = {
              "schedule": "onecycle", "weight_decay": 1e-4, "ridge": True,
              "model": {"dropout": 0.1, "octaves": 4, "global_width": 256,
                        "head": [128, 128, 64], "keypoints": 32}},
+    "rays": {"optimizer": "adamw", "lr": 2e-3, "batch": 4, "pos_weight": "auto",
+             "schedule": "onecycle", "weight_decay": 1e-4, "ridge": False,
+             "model": {"inputs": 8, "dropout": 0.1, "octaves": 2, "global_width": 128,
+                       "head": [64, 64, 32]}},
 }
 
 
@@ -71,6 +82,18 @@ def ridge_targets(sample, tail: float = 0.45, width: float = 2.0) -> np.ndarray:
         ridge = tail * np.exp(-(distance / (width * spacing)) ** 2)
         out[:, c] = np.where(on, 1.0, ridge)
     return out
+
+
+def input_columns(samples, width: int, data_path) -> list:
+    """The samples with the first `width` input columns (a data set holds the paper's four
+    and the ray hints; a model takes what it was built for)."""
+    have = samples[0].x.shape[1] if samples else width
+    if have < width:
+        raise ValueError(f"{data_path}: has {have} input columns, the model takes {width} "
+                         "(regenerate it with 'quadcnn dataset')")
+    if have == width:
+        return samples
+    return [dataclasses.replace(s, x=np.ascontiguousarray(s.x[:, :width])) for s in samples]
 
 
 def split(n: int, seed: int, fraction: float = 0.2):
@@ -143,6 +166,8 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
     samples, meta = load_dataset(data_path)
     if len(samples) < 2:
         raise ValueError(f"{data_path}: needs at least 2 samples, has {len(samples)}")
+    architecture = settings.get("model", {})
+    samples = input_columns(samples, architecture.get("inputs", 4), data_path)
     torch.manual_seed(seed)
     torch.set_num_threads(threads)
     torch.use_deterministic_algorithms(True, warn_only=True)
@@ -155,7 +180,6 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
         pos_weight = float(np.sqrt((1 - ones) / max(ones, 1e-6)))
     targets = ({i: ridge_targets(samples[i]) for i in train_idx} if settings.get("ridge")
                else None)
-    architecture = settings.get("model", {})
     net = QuadCNN(**architecture)
     if init is not None:
         try:
@@ -229,7 +253,8 @@ def train(data_path, out_path, epochs: int = 30, seed: int = 0, recipe: str = "p
     export_onnx(net, out_path)
     metadata = {
         "family": meta.get("family"), "topology": meta.get("topology"), **(meta_extra or {}),
-        "input": ENCODING, "input_shape": ["batch", "points", 4],
+        "input": ENCODING + ("; then " + RAY_ENCODING if net.inputs > 4 else ""),
+        "input_shape": ["batch", "points", net.inputs],
         "output": "probabilities of label 1 for v1 and v2", "threshold": threshold,
         "architecture": {"k": net.k, **architecture},
         "parameters": sum(p.numel() for p in net.parameters()),
@@ -255,7 +280,7 @@ def export_onnx(net: QuadCNN, path) -> None:
 
     net.eval()
     wrapped = Probabilities(net).eval()  # export restores this mode afterwards
-    example = torch.zeros(1, 64, 4)
+    example = torch.zeros(1, 64, net.inputs)
     example[..., :2] = torch.rand(1, 64, 2)
 
     def write(tmp):

@@ -1,0 +1,159 @@
+"""Straight-ray hints: where the separatrices would run if they did not bend.
+
+The paper's network sees only positions and frames and must discover, from the whole
+shape, where the singular points are and which way their streamlines leave; on a CPU
+budget that is the slow part of learning (a band one element wide, placed by global
+geometry).  The field already knows the sources (singular points and concave corners)
+and their leaving directions — reconstruction uses them anyway — so the "rays" recipe
+hands them to the network as per-node distances: how far (in element sizes) the node is
+from the nearest straight ray whose direction matches v1, and likewise v2, each ray cut
+where it first meets the boundary or passes another source.  Streamlines bend (around
+holes, near the boundary), so the hints are wrong there: the network learns where and how.
+Everything is computed with array operations over (nodes × rays), a few milliseconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+CLIP = 4.0  # distances beyond this many element sizes all read as "far"
+FEATURES = ("ray distance v1", "ray distance v2", "boundary distance", "source distance")
+RAY_ENCODING = ("rays: distance / h to the nearest coarse separatrix ray heading along v1, "
+                "along v2, distance to the boundary / h, to the nearest source / h; each "
+                f"clipped at {CLIP} and divided by it")
+
+
+@dataclass(frozen=True)
+class Rays:
+    starts: np.ndarray  # (R, 2)
+    directions: np.ndarray  # (R, 2) unit
+    sources: np.ndarray  # (S, 2) singular points and source corners
+
+
+def field_rays(field) -> Rays:
+    """Every separatrix of the field's singular points and source corners as a ray."""
+    starts, dirs, points = [], [], []
+    for src in (*field.singularities, *field.corner_sources):
+        points.append(src.xy)
+        for d in src.directions:
+            starts.append(src.xy)
+            dirs.append(d)
+    return Rays(np.array(starts, float).reshape(-1, 2), np.array(dirs, float).reshape(-1, 2),
+                np.array(points, float).reshape(-1, 2))
+
+
+def boundary_edges(triangles: np.ndarray) -> np.ndarray:
+    """(E, 2) node pairs of the edges that belong to one triangle only."""
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]],
+                                    triangles[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    return unique[counts == 1]
+
+
+def bent_rays(rays: Rays, nodes: np.ndarray, theta: np.ndarray, edges: np.ndarray, h: float,
+              step: float = 1.0) -> list:
+    """Each ray marched along the field (midpoint steps of `step`·h, the cross arm closest
+    to the heading, the field averaged from the 3 nearest nodes), stopped where it
+    crosses the boundary or comes within 0.7 h of another source.
+
+    A coarse hint, not a streamline: no triangle walking, no exact snapping, all rays
+    marched together.  Returns one (M, 2) polyline per ray.
+    """
+    r = len(rays.starts)
+    if not r:
+        return []
+    tree = cKDTree(nodes)
+    boundary_tree = cKDTree(nodes[np.unique(edges)])
+    z = np.exp(4j * theta)
+    a, e = nodes[edges[:, 0]], nodes[edges[:, 1]] - nodes[edges[:, 0]]
+    reach = step * h + float(np.hypot(*e.T).max())  # farther from the boundary: no crossing
+    diag = float(np.hypot(*np.ptp(nodes, axis=0)))
+    sources = rays.sources
+    foreign = np.hypot(*(sources[None] - rays.starts[:, None, :]).transpose(2, 0, 1)) \
+        > 1e-9 * diag  # (R, S): the sources a ray may end at
+    pos, head = rays.starts.copy(), rays.directions.copy()
+    alive = np.ones(r, bool)
+    steps = np.zeros(r, int)
+    history = [pos.copy()]
+    for count in range(1, int(np.ceil(1.5 * diag / (step * h))) + 1):
+        idx = np.nonzero(alive)[0]
+        if not len(idx):
+            break
+        mid = pos[idx] + 0.5 * step * h * _arm(tree, z, pos[idx], head[idx])
+        new_head = _arm(tree, z, mid, head[idx])
+        move = step * h * new_head
+        frac = np.ones(len(idx))
+        hit = np.zeros(len(idx), bool)
+        close = boundary_tree.query(pos[idx])[0] < reach
+        if close.any():  # first boundary crossing of pos -> pos + move, for those near it
+            c = np.nonzero(close)[0]
+            q = a[None] - pos[idx[c], None, :]
+            m = move[c]
+            denom = m[:, None, 0] * e[None, :, 1] - m[:, None, 1] * e[None, :, 0]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (q[..., 0] * e[None, :, 1] - q[..., 1] * e[None, :, 0]) / denom
+                u = (q[..., 0] * m[:, None, 1] - q[..., 1] * m[:, None, 0]) / denom
+            first = (count == 1)  # a corner's rays start on the boundary
+            cross = (np.abs(denom) > 1e-15) & (t > (1.0 if first else 0.0)) & (t <= 1) \
+                & (u >= 0) & (u <= 1)
+            t_hit = np.where(cross, t, np.inf).min(axis=1)
+            hit[c] = np.isfinite(t_hit)
+            frac[c] = np.where(hit[c], t_hit, 1.0)
+        new_pos = pos[idx] + frac[:, None] * move
+        stop = hit
+        if len(sources):
+            gap = np.hypot(*(sources[None] - new_pos[:, None, :]).transpose(2, 0, 1))
+            gap = np.where(foreign[idx], gap, np.inf)
+            k = np.argmin(gap, axis=1)
+            snap = (gap[np.arange(len(idx)), k] < 0.7 * h) & ~stop
+            new_pos[snap] = sources[k[snap]]
+            stop = stop | snap
+        pos[idx], head[idx] = new_pos, new_head
+        steps[idx] = count
+        alive[idx[stop]] = False
+        history.append(pos.copy())
+    track = np.stack(history)  # (steps + 1, R, 2); a stopped ray repeats its end
+    return [track[: steps[i] + 1, i] for i in range(r)]
+
+
+def _arm(tree, z, points, heading):
+    """The unit cross arm at each point (inverse-distance mean of the 3 nearest nodes'
+    exp(4it)) closest to its heading."""
+    dist, near = tree.query(points, k=3)
+    w = 1.0 / np.maximum(dist, 1e-12)
+    t = np.angle((w * z[near]).sum(axis=1)) / 4.0
+    arms = t[:, None] + np.arange(4)[None] * (np.pi / 2)
+    dots = np.cos(arms) * heading[:, 0:1] + np.sin(arms) * heading[:, 1:2]
+    best = arms[np.arange(len(points)), np.argmax(dots, axis=1)]
+    return np.column_stack([np.cos(best), np.sin(best)])
+
+
+def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, rays: Rays,
+                 h: float) -> np.ndarray:
+    """(N, 4) float32 hints in [0, 1] (see FEATURES), 0 meaning "on it"."""
+    from ..core.labels import resample
+
+    out = np.ones((len(nodes), 4))
+    edges = boundary_edges(triangles)
+    lines = [p for p in bent_rays(rays, nodes, theta, edges, h) if len(p) > 1]
+    if lines:
+        pts, dirs = zip(*(resample(p, 0.25 * h) for p in lines))
+        pts, dirs = np.concatenate(pts), np.concatenate(dirs)
+        dist, near = cKDTree(pts).query(nodes, k=min(8, len(pts)),
+                                        distance_upper_bound=CLIP * h)
+        dist, near = dist.reshape(len(nodes), -1), near.reshape(len(nodes), -1)
+        found = near < len(pts)
+        d = dirs[np.where(found, near, 0)]  # (N, k, 2)
+        c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
+        with_v1 = np.abs(c * d[..., 0] + s * d[..., 1]) >= np.abs(c * d[..., 1] - s * d[..., 0])
+        for column, aligned in ((0, with_v1), (1, ~with_v1)):
+            best = np.where(found & aligned, dist, np.inf).min(axis=1)
+            out[:, column] = np.minimum(best / h, CLIP) / CLIP
+    boundary = np.unique(edges)
+    out[:, 2] = np.minimum(cKDTree(nodes[boundary]).query(nodes)[0] / h, CLIP) / CLIP
+    if len(rays.sources):
+        out[:, 3] = np.minimum(cKDTree(rays.sources).query(nodes)[0] / h, CLIP) / CLIP
+    return out.astype(np.float32)
