@@ -16,8 +16,7 @@ from quadcnn_wb.core.reference import numerical_reference
 from quadcnn_wb.core.transform import similarity, transform_domain_json
 from quadcnn_wb.infer.encoding import model_input
 from quadcnn_wb.infer.metrics import Confusion
-from quadcnn_wb.infer.rays import (CLIP, bent_rays, boundary_edges, field_rays,
-                                   ray_features)
+from quadcnn_wb.infer.rays import CLIP, bent_rays, boundary_edges, field_rays, ray_features
 
 
 @functools.cache

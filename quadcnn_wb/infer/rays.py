@@ -157,3 +157,9 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
     if len(rays.sources):
         out[:, 3] = np.minimum(cKDTree(rays.sources).query(nodes)[0] / h, CLIP) / CLIP
     return out.astype(np.float32)
+
+
+def hint_labels(x: np.ndarray) -> np.ndarray:
+    """(N, 2) labels the hints alone give (a vector within one element size of a ray
+    heading its way): the baseline a "rays" model has to beat.  x: encoded, 8 columns."""
+    return (x[:, 4:6] * CLIP < 1.0).astype(np.uint8)
