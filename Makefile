@@ -93,12 +93,12 @@ models: setup
 	$(PY) -m quadcnn_wb dataset concave -n 2000 --seed 1 --workers 2 -o data/concave.npz
 	$(PY) -m quadcnn_wb dataset four_hole -n 2000 --seed 2 --workers 2 -o data/four_hole.npz
 	$(PY) -m quadcnn_wb dataset semicircle -n 1200 --seed 3 --workers 2 -o data/semicircle.npz
-	$(PY) -m quadcnn_wb train data/concave.npz -o resources/models/concave.onnx --recipe fast \
-	    --epochs 20 --patience 8 --minutes 100 --threads 1 --seed 0
+	$(PY) -m quadcnn_wb train data/concave.npz -o resources/models/concave.onnx --recipe rays \
+	    --epochs 10 --minutes 45 --threads 1 --seed 0
 	$(PY) -m quadcnn_wb train data/four_hole.npz -o resources/models/four_hole.onnx \
-	    --recipe fast --epochs 20 --patience 8 --minutes 100 --threads 1 --seed 0
+	    --recipe rays --epochs 10 --minutes 45 --threads 1 --seed 0
 	$(PY) -m quadcnn_wb train data/semicircle.npz -o resources/models/semicircle.onnx \
-	    --recipe fast --epochs 8 --patience 8 --minutes 60 --threads 1 --seed 0
+	    --recipe rays --epochs 10 --minutes 40 --threads 1 --seed 0
 
 robustness: setup
 	$(PY) -m quadcnn_wb.bench.robustness -n 500 --seed 0

@@ -7,8 +7,15 @@ current direction, until a singular point or the boundary is reached.  The node 
 then Laplace-smoothed, fitted by a smoothing spline and its ends snapped exactly onto the
 singular point or the boundary curve.
 
-Trust but verify: a walk that stalls, turns back, leaves the domain or runs far too long
-is reported, and the caller traces that separatrix numerically instead (`fallback`).
+Two departures from the letter of §4, both needed where streamlines lie a few elements
+apart (four holes): after each hop the walk moves across its heading onto the middle of
+the labelled band (hopping between nodes drifts to one side, over to the next band), and
+it ends at a singular point only when it closes in on it along one of its separatrices
+(as numerical tracing does), never because it passes beside it.
+
+Trust but verify: a walk that stalls, turns back, jumps over a gap, leaves the domain,
+runs far too long, or whose smoothed line runs across the field, is reported, and the
+caller traces that separatrix numerically instead (`fallback`).
 """
 
 from __future__ import annotations
@@ -22,12 +29,14 @@ from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
 from ..core.curves import winding_number
-from ..core.tracing import MAX_LENGTH, SNAP, Endpoint, Streamline
+from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
 
 NEIGHBOURS = 12  # m of the paper
 MIN_STEP = 0.35  # a next node must lie this far ahead (element sizes)
+MAX_STEP = 2.0  # and no farther than this (element sizes): a longer jump crosses a gap
 MAX_TURN = math.radians(50)  # a step turning more than this counts as turning back
 SMOOTHING_PASSES = 5
+MAX_STRAY = 20.0  # degrees a rebuilt line may run across the field (over an element)
 
 
 @dataclass(frozen=True)
@@ -69,7 +78,8 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, start_xy, directi
         idx = np.atleast_1d(idx)
         offsets = vectors.points[idx] - current
         ahead = offsets @ heading
-        ok = (ahead >= MIN_STEP * h) & np.array([i not in used for i in idx])
+        ok = (ahead >= MIN_STEP * h) & (np.atleast_1d(dist) <= MAX_STEP * h) \
+            & np.array([i not in used for i in idx])
         if not ok.any():
             end = _boundary_end(domain, current, boundary_tree, boundary_ids, mesh, h)
             if end is not None:
@@ -86,12 +96,13 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, start_xy, directi
             return Walk(None, "turned back")
         used.add(chosen)
         current = vectors.points[chosen]
+        current = _band_centre(vectors, current, new_heading, h)
         heading = new_heading
         travelled += float(np.hypot(*step_vec))
         path.append(current.copy())
         if travelled > limit:
             return Walk(None, "ran longer than any streamline should")
-        snapped = _snap(current, travelled, origin, targets, target_kind, h)
+        snapped = _snap(current, path[-2], travelled, origin, targets, target_kind, field, h)
         if snapped is not None:
             return Walk(_finish(field, path[:-1] + [snapped[1]], origin, snapped[0], h,
                                     direction))
@@ -104,21 +115,81 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, start_xy, directi
     return Walk(None, "ran longer than any streamline should")
 
 
+def _stray(line, node_tree, theta, h) -> str:
+    """Why a rebuilt line cannot be a streamline, or "": it must run along the field.
+
+    Away from its ends (where the field turns fast around a singular point) a streamline
+    is tangent to a cross arm everywhere; a walk that crossed over to a neighbouring
+    band of labels, or cut a corner through a gap, runs across the field there.
+    """
+    pts = line.points
+    seg = np.diff(pts, axis=0)
+    length = np.hypot(*seg.T)
+    s = np.concatenate([[0.0], np.cumsum(length)])
+    inner = (s[:-1] > 1.5 * h) & (s[1:] < s[-1] - 1.5 * h) & (length > 0)
+    if not inner.any():
+        return ""
+    mid = 0.5 * (pts[:-1] + pts[1:])[inner]
+    dist, near = node_tree.query(mid, k=3)
+    w = 1.0 / np.maximum(dist, 1e-12)
+    t = np.angle((w * np.exp(4j * theta[near])).sum(axis=1)) / 4.0
+    angle = np.arctan2(seg[inner, 1], seg[inner, 0]) - t
+    off = np.abs((angle + np.pi / 4) % (np.pi / 2) - np.pi / 4)  # to the nearest arm
+    # over stretches of about an element: single wiggles of the spline do not count
+    window = max(1, int(round(h / max(float(np.median(length[inner])), 1e-300))))
+    smooth = np.convolve(off, np.ones(window) / window, mode="valid") if len(off) >= window \
+        else off
+    worst = float(np.degrees(smooth.max()))
+    return f"runs {worst:.0f}° across the field" if worst > MAX_STRAY else ""
+
+
+def _band_centre(vectors, p, heading, h):
+    """p moved across the heading onto the middle of the labelled band around it.
+
+    The label-1 nodes are those of the triangles a streamline crosses, so they lie on
+    both sides of it; hopping from node to node drifts to one side (the paper's choice
+    looks at the vectors' angles, not at where the nodes lie), and in a dense layout
+    the drift carries a walk over to a neighbouring streamline.
+    """
+    near = vectors.tree.query_ball_point(p, 1.0 * h)
+    if not near:
+        return p
+    near = np.asarray(near)
+    aligned = near[np.abs(vectors.vectors[near] @ heading) > math.cos(math.radians(20))]
+    if not len(aligned):
+        return p
+    normal = np.array([-heading[1], heading[0]])
+    shift = float(np.mean((vectors.points[aligned] - p) @ normal))
+    return p + shift * normal
+
+
 def _inside(domain, p) -> bool:
     return winding_number(domain.loops[0], p) != 0 and all(
         winding_number(hole, p) == 0 for hole in domain.loops[1:])
 
 
-def _snap(p, travelled, origin, targets, target_kind, h):
+def _snap(p, prev, travelled, origin, targets, target_kind, field, h):
+    """The source a walk ends at: as numerical tracing decides it (core.tracing), a walk
+    snaps only while closing in on a point, and on a singular point only when it arrives
+    along one of its separatrices — in a dense layout (four holes) a walk passing beside
+    another singular point must not end there."""
     if not len(targets):
         return None
     d = np.hypot(*(targets - p).T)
+    before = np.hypot(*(targets - prev).T)
     for j in np.argsort(d)[:3]:
         if d[j] > SNAP * h:
             break
+        if d[j] >= before[j]:
+            continue
         target = target_kind[j]
         if target.same_place(origin) and (target.kind == "corner" or travelled < 3 * SNAP * h):
             continue
+        if target.kind == "singularity":
+            radial = (p - targets[j]) / max(d[j], 1e-300)
+            if np.max(field.singularities[target.index].directions @ radial) < \
+                    math.cos(SNAP_ANGLE):
+                continue
         return target, targets[j].copy()
     return None
 
@@ -194,15 +265,18 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
     boundary_ids = mesh.boundary_nodes
     boundary_tree = cKDTree(mesh.nodes[boundary_ids])
     targets, target_kind = _snap_targets(mesh, field)
+    node_tree = cKDTree(mesh.nodes)
     lines, failed, problems = [], [], []
     for source in sources:
         xy, direction, _, origin = source
         walk = walk_labels(domain, mesh, field, vectors, xy, direction, origin,
                            boundary_tree, boundary_ids, targets, target_kind)
-        if walk.line is None:
+        problem = walk.problem if walk.line is None else _stray(walk.line, node_tree,
+                                                                  field.theta, h)
+        if problem:
             failed.append(source)
             problems.append((f"{origin.kind} {origin.index} branch {origin.branch}",
-                             walk.problem))
+                             problem))
         else:
             lines.append(dataclasses.replace(walk.line, start_direction=direction))
     if failed:
