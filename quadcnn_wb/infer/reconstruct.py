@@ -175,7 +175,9 @@ def _snap(p, prev, travelled, origin, targets, target_kind, field, h):
     another singular point must not end there."""
     if not len(targets):
         return None
-    d = np.hypot(*(targets - p).T)
+    step = p - prev
+    along = np.clip((targets - prev) @ step / max(float(step @ step), 1e-300), 0.0, 1.0)
+    d = np.hypot(*(targets - (prev + along[:, None] * step)).T)  # closest on the hop
     before = np.hypot(*(targets - prev).T)
     for j in np.argsort(d)[:3]:
         if d[j] > SNAP * h:
@@ -186,7 +188,7 @@ def _snap(p, prev, travelled, origin, targets, target_kind, field, h):
         if target.same_place(origin) and (target.kind == "corner" or travelled < 3 * SNAP * h):
             continue
         if target.kind == "singularity":
-            radial = (p - targets[j]) / max(d[j], 1e-300)
+            radial = (prev - targets[j]) / max(before[j], 1e-300)
             if np.max(field.singularities[target.index].directions @ radial) < \
                     math.cos(SNAP_ANGLE):
                 continue
