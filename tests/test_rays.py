@@ -59,7 +59,7 @@ def test_rays_end_on_the_boundary_or_at_a_source(name):
         to_source = np.hypot(*(rays.sources - end).T).min()
         assert min(to_boundary, to_source) < 1.5 * h
         steps = np.hypot(*np.diff(line, axis=0).T)
-        assert steps.max() <= 0.5 * h * (1 + 1e-9) + 0.7 * h  # half-element steps, snaps
+        assert steps.max() <= h * (1 + 1e-9) + 0.7 * h  # one-element steps, snaps
 
 
 def test_hints_ignore_placement_scale_and_mirror():
@@ -74,7 +74,7 @@ def test_hints_ignore_placement_scale_and_mirror():
     same = np.isclose(ha, hb, atol=1e-4).all(axis=1)
     # the coarse march is not exactly frame-free (a ray may pass a node a step apart),
     # so a few per cent of nodes see a hint differ a little
-    assert same.mean() > 0.95 and np.abs(ha - hb).mean() < 0.01
+    assert same.mean() > 0.9 and np.abs(ha - hb).mean() < 0.01
 
 
 def test_model_input_width():
