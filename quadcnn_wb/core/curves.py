@@ -231,3 +231,21 @@ def winding_number(loop, q) -> int:
             if inside:
                 total += TWO_PI if c.sweep > 0 else -TWO_PI
     return int(round(total / TWO_PI))
+
+
+def winding_numbers(loop, points: np.ndarray) -> np.ndarray:
+    """winding_number for many points at once (none may lie on the loop)."""
+    q = np.asarray(points, dtype=float).reshape(-1, 2)
+    total = np.zeros(len(q))
+    for c in loop:
+        a, b = c.p0 - q, c.p1 - q
+        total += np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))
+        if isinstance(c, Arc):
+            inside = np.hypot(*(q - c.center).T) < c.radius
+            if not c.is_full:
+                chord = c.p1 - c.p0
+                rel = q - c.p0
+                side = chord[0] * rel[:, 1] - chord[1] * rel[:, 0]
+                inside &= side * cross2(chord, c.midpoint() - c.p0) > 0.0
+            total += np.where(inside, TWO_PI if c.sweep > 0 else -TWO_PI, 0.0)
+    return np.rint(total / TWO_PI).astype(int)

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
-from ..core.curves import winding_number
+from ..core.curves import winding_numbers
 from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
 
 NEIGHBOURS = 12  # m of the paper
@@ -62,57 +62,155 @@ class LabelledVectors:
         return len(self.points)
 
 
-def walk_labels(domain, mesh, field, vectors: LabelledVectors, start_xy, direction, origin,
-                boundary_tree, boundary_ids, targets, target_kind) -> Walk:
-    """One streamline from start_xy along direction over the labelled vectors."""
+def walk_labels(domain, mesh, field, vectors: LabelledVectors, sources, boundary_tree,
+                boundary_ids, targets, target_kind) -> list:
+    """One Walk per source (xy, direction, triangle, origin), all walked together.
+
+    Each step, for every walk still under way: among the m nearest labelled vectors that
+    lie ahead (at least MIN_STEP, at most MAX_STEP) and were not taken before, the one
+    most parallel to the heading; then onto the band's middle, and the checks (turned
+    back, too long, a source reached, the boundary reached, left the domain).  The walks
+    are independent: batching them turns one tree query per step and walk into one per
+    step, which is most of the cost.
+    """
     h = mesh.element_size
-    if vectors.tree is None:
-        return Walk(None, "no label-1 vectors")
-    path = [np.asarray(start_xy, dtype=float)]
-    current, heading = path[0], np.asarray(direction, dtype=float)
-    used = set()
-    travelled, limit = 0.0, MAX_LENGTH * domain.size
+    r = len(sources)
+    if vectors.tree is None or not r:
+        return [Walk(None, "no label-1 vectors") for _ in range(r)]
+    start = np.array([np.asarray(s[0], dtype=float) for s in sources]).reshape(-1, 2)
+    start_dir = np.array([np.asarray(s[1], dtype=float) for s in sources]).reshape(-1, 2)
+    origins = [s[3] for s in sources]
+    snap = _SnapTargets(targets, target_kind, field, origins)
+    current, heading = start.copy(), start_dir.copy()
+    paths = [[p.copy()] for p in start]
+    travelled = np.zeros(r)
+    used = np.zeros((r, len(vectors)), dtype=bool)
+    walks: list = [None] * r
+    active = np.arange(r)
+    limit = MAX_LENGTH * domain.size
+    k = min(NEIGHBOURS, len(vectors))
+
+    def finish(i, points, end):
+        walks[i] = Walk(_finish(field, points, origins[i], end, h, start_dir[i]))
+
+    def boundary_end(i):
+        end = _boundary_end(domain, current[i], boundary_tree, boundary_ids, mesh, h)
+        if end is not None:
+            finish(i, paths[i] + [end[1]], end[0])
+        return end is not None
+
     for _ in range(int(limit / (MIN_STEP * h)) + 2):
-        k = min(NEIGHBOURS, len(vectors))
-        dist, idx = vectors.tree.query(current, k=k)
-        idx = np.atleast_1d(idx)
-        offsets = vectors.points[idx] - current
-        ahead = offsets @ heading
-        ok = (ahead >= MIN_STEP * h) & (np.atleast_1d(dist) <= MAX_STEP * h) \
-            & np.array([i not in used for i in idx])
-        if not ok.any():
-            end = _boundary_end(domain, current, boundary_tree, boundary_ids, mesh, h)
-            if end is not None:
-                return Walk(_finish(field, path + [end[1]], origin, end[0], h, direction))
-            return Walk(None, "stalled: no labelled vector ahead")
-        cand = idx[ok]
-        vec = vectors.vectors[cand]
-        cosine = np.abs(vec @ heading)
-        best = int(np.argmax(cosine - 0.02 * (np.atleast_1d(dist)[ok] / h)))
-        chosen = int(cand[best])
-        step_vec = vectors.points[chosen] - current
-        new_heading = vec[best] * (1.0 if vec[best] @ heading >= 0 else -1.0)
-        if math.acos(min(1.0, abs(float(vec[best] @ heading)))) > MAX_TURN:
-            return Walk(None, "turned back")
-        used.add(chosen)
-        current = vectors.points[chosen]
-        current = _band_centre(vectors, current, new_heading, h)
-        heading = new_heading
-        travelled += float(np.hypot(*step_vec))
-        path.append(current.copy())
-        if travelled > limit:
-            return Walk(None, "ran longer than any streamline should")
-        snapped = _snap(current, path[-2], travelled, origin, targets, target_kind, field, h)
-        if snapped is not None:
-            return Walk(_finish(field, path[:-1] + [snapped[1]], origin, snapped[0], h,
-                                    direction))
-        if travelled > h:  # a corner source starts on the boundary itself
-            end = _boundary_end(domain, current, boundary_tree, boundary_ids, mesh, h)
-            if end is not None:
-                return Walk(_finish(field, path + [end[1]], origin, end[0], h, direction))
-        if not _inside(domain, current):
-            return Walk(None, "left the domain")
-    return Walk(None, "ran longer than any streamline should")
+        if not len(active):
+            break
+        dist, idx = vectors.tree.query(current[active], k=k)
+        dist, idx = dist.reshape(len(active), k), idx.reshape(len(active), k)
+        offsets = vectors.points[idx] - current[active, None, :]
+        ahead = np.einsum("akc,ac->ak", offsets, heading[active])
+        ok = (ahead >= MIN_STEP * h) & (dist <= MAX_STEP * h) & ~used[active[:, None], idx]
+        stalled = ~ok.any(axis=1)
+        for i in active[stalled]:
+            if not boundary_end(i):
+                walks[i] = Walk(None, "stalled: no labelled vector ahead")
+        rows, active = np.nonzero(~stalled)[0], active[~stalled]
+        if not len(active):
+            break
+        vec = vectors.vectors[idx[rows]]  # (A, k, 2)
+        along = np.einsum("akc,ac->ak", vec, heading[active])
+        score = np.where(ok[rows], np.abs(along) - 0.02 * dist[rows] / h, -np.inf)
+        best = np.argmax(score, axis=1)
+        pick = np.arange(len(active))
+        chosen = idx[rows, best]
+        cosine = along[pick, best]
+        new_heading = vec[pick, best] * np.where(cosine >= 0, 1.0, -1.0)[:, None]
+        turned = np.arccos(np.minimum(1.0, np.abs(cosine))) > MAX_TURN
+        for i in active[turned]:
+            walks[i] = Walk(None, "turned back")
+        active, chosen, new_heading = active[~turned], chosen[~turned], new_heading[~turned]
+        used[active, chosen] = True
+        target = vectors.points[chosen]
+        travelled[active] += np.hypot(*(target - current[active]).T)
+        previous = current[active].copy()
+        current[active] = _band_centres(vectors, target, new_heading, h)
+        heading[active] = new_heading
+        for i in active:
+            paths[i].append(current[i].copy())
+        going = np.ones(len(active), dtype=bool)
+        for j, i in enumerate(active):
+            if travelled[i] > limit:
+                walks[i] = Walk(None, "ran longer than any streamline should")
+                going[j] = False
+        hits = snap.reached(current[active], previous, travelled[active], active, h)
+        for j, i in enumerate(active):
+            if going[j] and hits[j] is not None:
+                finish(i, paths[i][:-1] + [hits[j][1]], hits[j][0])
+                going[j] = False
+        gap = boundary_tree.query(current[active])[0]
+        for j, i in enumerate(active):
+            if going[j] and travelled[i] > h and gap[j] <= 0.5 * h and boundary_end(i):
+                going[j] = False
+        active = active[going]
+        if len(active):
+            outside = ~_inside_all(domain, current[active])
+            for i in active[outside]:
+                walks[i] = Walk(None, "left the domain")
+            active = active[~outside]
+    for i in active:
+        walks[i] = Walk(None, "ran longer than any streamline should")
+    return walks
+
+
+class _SnapTargets:
+    """Where walks may end (singular points, source corners), as arrays, so every walk
+    under way is checked at once — by the rules of numerical tracing (core.tracing): a
+    walk snaps only while closing in on a point (the closest point of its last hop), not
+    on its own start unless it went round, and on a singular point only when it arrives
+    along one of that point's separatrices — in a dense layout (four holes) a walk
+    passing beside another singular point must not end there."""
+
+    def __init__(self, targets, target_kind, field, origins):
+        self.xy = np.asarray(targets, dtype=float).reshape(-1, 2)
+        self.kind = target_kind
+        t = len(self.xy)
+        self.own = np.array([[kind.same_place(o) for kind in target_kind] for o in origins],
+                            dtype=bool).reshape(len(origins), t)
+        self.corner = np.array([kind.kind == "corner" for kind in target_kind], dtype=bool)
+        dirs = np.full((t, 6, 2), np.nan)
+        for j, kind in enumerate(target_kind):
+            if kind.kind == "singularity":
+                d = field.singularities[kind.index].directions
+                dirs[j, :len(d)] = d
+        self.dirs = dirs
+        self.singular = np.array([kind.kind == "singularity" for kind in target_kind],
+                                 dtype=bool)
+
+    def reached(self, points, previous, travelled, walks, h) -> list:
+        """Per walk: (Endpoint, exact xy) of the source it ends at, or None."""
+        out = [None] * len(points)
+        if not len(self.xy):
+            return out
+        step = points - previous  # (A, 2)
+        rel = self.xy[None] - previous[:, None, :]  # (A, T, 2)
+        length2 = np.maximum((step * step).sum(axis=1), 1e-300)[:, None]
+        along = np.clip(np.einsum("atc,ac->at", rel, step) / length2, 0.0, 1.0)
+        d = np.hypot(*(rel - along[..., None] * step[:, None, :]).transpose(2, 0, 1))
+        before = np.hypot(*rel.transpose(2, 0, 1))
+        valid = (d <= SNAP * h) & (d < before)
+        own = self.own[walks]
+        valid &= ~(own & (self.corner[None] | (travelled[:, None] < 3 * SNAP * h)))
+        radial = -rel / np.maximum(before, 1e-300)[..., None]
+        facing = np.nanmax(np.where(np.isnan(self.dirs[None, :, :, 0]), -np.inf,
+                                    np.einsum("tsc,atc->ats", np.nan_to_num(self.dirs),
+                                              radial)), axis=2)
+        valid &= ~self.singular[None] | (facing >= math.cos(SNAP_ANGLE))
+        order = np.argsort(d, axis=1)[:, :3]  # the three nearest, as tracing looks
+        for a in range(len(points)):
+            for j in order[a]:
+                if d[a, j] > SNAP * h:
+                    break
+                if valid[a, j]:
+                    out[a] = (self.kind[j], self.xy[j].copy())
+                    break
+        return out
 
 
 def _stray(line, node_tree, theta, h) -> str:
@@ -143,57 +241,33 @@ def _stray(line, node_tree, theta, h) -> str:
     return f"runs {worst:.0f}° across the field" if worst > MAX_STRAY else ""
 
 
-def _band_centre(vectors, p, heading, h):
-    """p moved across the heading onto the middle of the labelled band around it.
+def _band_centres(vectors, points, headings, h):
+    """Each point moved across its heading onto the middle of the labelled band there.
 
     The label-1 nodes are those of the triangles a streamline crosses, so they lie on
     both sides of it; hopping from node to node drifts to one side (the paper's choice
     looks at the vectors' angles, not at where the nodes lie), and in a dense layout
     the drift carries a walk over to a neighbouring streamline.
     """
-    near = vectors.tree.query_ball_point(p, 1.0 * h)
-    if not near:
-        return p
-    near = np.asarray(near)
-    aligned = near[np.abs(vectors.vectors[near] @ heading) > math.cos(math.radians(20))]
-    if not len(aligned):
-        return p
-    normal = np.array([-heading[1], heading[0]])
-    shift = float(np.mean((vectors.points[aligned] - p) @ normal))
-    return p + shift * normal
+    k = min(40, len(vectors))  # more than a band holds within one element
+    dist, idx = vectors.tree.query(points, k=k, distance_upper_bound=1.0 * h)
+    dist, idx = dist.reshape(len(points), k), idx.reshape(len(points), k)
+    found = idx < len(vectors)
+    safe = np.where(found, idx, 0)
+    aligned = found & (np.abs(np.einsum("akc,ac->ak", vectors.vectors[safe], headings))
+                       > math.cos(math.radians(20)))
+    normal = np.column_stack([-headings[:, 1], headings[:, 0]])
+    offset = np.einsum("akc,ac->ak", vectors.points[safe] - points[:, None, :], normal)
+    count = aligned.sum(axis=1)
+    shift = np.where(count > 0, (offset * aligned).sum(axis=1) / np.maximum(count, 1), 0.0)
+    return points + shift[:, None] * normal
 
 
-def _inside(domain, p) -> bool:
-    return winding_number(domain.loops[0], p) != 0 and all(
-        winding_number(hole, p) == 0 for hole in domain.loops[1:])
-
-
-def _snap(p, prev, travelled, origin, targets, target_kind, field, h):
-    """The source a walk ends at: as numerical tracing decides it (core.tracing), a walk
-    snaps only while closing in on a point, and on a singular point only when it arrives
-    along one of its separatrices — in a dense layout (four holes) a walk passing beside
-    another singular point must not end there."""
-    if not len(targets):
-        return None
-    step = p - prev
-    along = np.clip((targets - prev) @ step / max(float(step @ step), 1e-300), 0.0, 1.0)
-    d = np.hypot(*(targets - (prev + along[:, None] * step)).T)  # closest on the hop
-    before = np.hypot(*(targets - prev).T)
-    for j in np.argsort(d)[:3]:
-        if d[j] > SNAP * h:
-            break
-        if d[j] >= before[j]:
-            continue
-        target = target_kind[j]
-        if target.same_place(origin) and (target.kind == "corner" or travelled < 3 * SNAP * h):
-            continue
-        if target.kind == "singularity":
-            radial = (prev - targets[j]) / max(before[j], 1e-300)
-            if np.max(field.singularities[target.index].directions @ radial) < \
-                    math.cos(SNAP_ANGLE):
-                continue
-        return target, targets[j].copy()
-    return None
+def _inside_all(domain, points) -> np.ndarray:
+    inside = winding_numbers(domain.loops[0], points) != 0
+    for hole in domain.loops[1:]:
+        inside &= winding_numbers(hole, points) == 0
+    return inside
 
 
 def _boundary_end(domain, p, boundary_tree, boundary_ids, mesh, h):
@@ -269,10 +343,10 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
     targets, target_kind = _snap_targets(mesh, field)
     node_tree = cKDTree(mesh.nodes)
     lines, failed, problems = [], [], []
-    for source in sources:
+    walks = walk_labels(domain, mesh, field, vectors, sources, boundary_tree, boundary_ids,
+                        targets, target_kind)
+    for source, walk in zip(sources, walks):
         xy, direction, _, origin = source
-        walk = walk_labels(domain, mesh, field, vectors, xy, direction, origin,
-                           boundary_tree, boundary_ids, targets, target_kind)
         problem = walk.problem if walk.line is None else _stray(walk.line, node_tree,
                                                                   field.theta, h)
         if problem:
