@@ -10,7 +10,7 @@ import pytest
 from conftest import circle, rect
 
 from quadcnn_wb.core.background import background_mesh
-from quadcnn_wb.core.curves import winding_number
+from quadcnn_wb.core.curves import winding_number, winding_numbers
 from quadcnn_wb.core.domain import domain_from_json, load_domain
 
 EXPECTED_CORNERS = {  # interior angles in degrees, sorted
@@ -95,6 +95,17 @@ def test_tangents_are_unit_with_the_domain_on_their_left(example_path):
         inside = winding_number(domain.loops[0], left) != 0 and all(
             winding_number(hole, left) == 0 for hole in domain.loops[1:])
         assert inside
+
+
+def test_winding_numbers_of_many_points_match_one_by_one(example_path):
+    """The batched test the label walks use agrees with the scalar one, arcs included."""
+    domain = load_domain(example_path)
+    corners = np.array([c.p0 for loop in domain.loops for c in loop])
+    lo, hi = corners.min(axis=0) - domain.size, corners.max(axis=0) + domain.size
+    points = np.random.default_rng(3).uniform(lo, hi, size=(500, 2))
+    for loop in domain.loops:
+        one_by_one = [winding_number(loop, p) for p in points]
+        assert np.array_equal(winding_numbers(loop, points), one_by_one)
 
 
 def test_corners_and_their_interior_angles(example_path):
