@@ -1,15 +1,17 @@
-"""Straight-ray hints: where the separatrices would run if they did not bend.
+"""Ray hints: roughly where the separatrices run, for the network to refine.
 
 The paper's network sees only positions and frames and must discover, from the whole
 shape, where the singular points are and which way their streamlines leave; on a CPU
 budget that is the slow part of learning (a band one element wide, placed by global
-geometry).  The field already knows the sources (singular points and concave corners)
-and their leaving directions — reconstruction uses them anyway — so the "rays" recipe
-hands them to the network as per-node distances: how far (in element sizes) the node is
-from the nearest straight ray whose direction matches v1, and likewise v2, each ray cut
-where it first meets the boundary or passes another source.  Streamlines bend (around
-holes, near the boundary), so the hints are wrong there: the network learns where and how.
-Everything is computed with array operations over (nodes × rays), a few milliseconds.
+geometry: the fast recipe reached IoU 0.39 on concave in 100 minutes).  The field already
+knows the sources (singular points and concave corners) and their leaving directions —
+reconstruction uses them anyway — so the "rays" recipe hands them to the network as
+per-node distances: how far (in element sizes) the node is from the nearest coarse ray
+heading along v1, and likewise v2.  The rays are marched through the field with steps of
+a whole element and stopped at the boundary or next to another source; they end early or
+late where several streamlines meet, drift, and know nothing of the crossed-triangle
+rule of the labels, which is what the network learns (docs/learning.md compares the
+hints alone with the trained models).  All rays are marched together, a few ms.
 """
 
 from __future__ import annotations
