@@ -38,6 +38,14 @@ def test_reference_labels_rebuild_the_reference_partition(name):
     h = ref.mesh.element_size
     for line in lines:  # each rebuilt line lies along one traced line
         assert min(hausdorff(line.points, other.points) for other in ref.streamlines) < 1.5 * h
+        # and leaves / arrives exactly along a separatrix: smoothing must not bend the
+        # ends into a neighbouring separatrix (a sliver block at the singular point)
+        for end, p0, p1 in ((line.start, line.points[0], line.points[1]),
+                            (line.end, line.points[-1], line.points[-2])):
+            if end.kind == "singularity":
+                out = (p1 - p0) / np.hypot(*(p1 - p0))
+                seps = ref.field.singularities[end.index].directions
+                assert np.max(seps @ out) > 1 - 1e-9
         if line.end.kind == "boundary":
             curve = ref.domain.loops[line.end.loop][line.end.segment]
             assert np.array_equal(line.points[-1], curve.point(line.end.param))

@@ -302,6 +302,7 @@ def _finish(field, points, origin, end, h, direction) -> Streamline:
         keep = np.hypot(*(pts - first).T) > 1.5 * h
         keep[0] = True
         pts = np.vstack([first, first + 0.75 * h * np.asarray(direction), pts[keep][1:]])
+    sep = None
     if end.kind == "singularity":
         seps = field.singularities[end.index].directions
         back = pts[-2] - last if len(pts) > 1 else seps[0]
@@ -322,6 +323,17 @@ def _finish(field, points, origin, end, h, direction) -> Streamline:
         except (ValueError, TypeError):
             pass
     pts[0], pts[-1] = first, last
+    # The smoothing bends the first and last stretch again; within half an element of a
+    # singular point that can cross the point's next separatrix (a sliver block), so the
+    # ends are put back on the separatrix exactly.
+    if origin.kind in ("singularity", "corner") and len(pts) > 2:
+        away = np.nonzero(np.hypot(*(pts - first).T) >= 0.75 * h)[0]  # the leading stretch
+        if len(away):
+            pts = np.vstack([first, first + 0.5 * h * np.asarray(direction), pts[away[0]:]])
+    if sep is not None and len(pts) > 2:
+        away = np.nonzero(np.hypot(*(pts - last).T) >= 0.75 * h)[0]  # the trailing one
+        if len(away):
+            pts = np.vstack([pts[:away[-1] + 1], last + 0.5 * h * sep, last])
     return Streamline(points=pts, start=origin, end=end, capped=False,
                       start_direction=None)
 
