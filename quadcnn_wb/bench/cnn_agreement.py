@@ -14,7 +14,6 @@ same run (the paper: 0.782 s against 1.644 s).
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
@@ -28,6 +27,7 @@ from ..infer.cnn import cnn_streamlines
 from ..infer.models import model_paths
 from ..infer.predictor import Predictor
 from ..learn.families import family
+from .common import model_options, print_table_header
 
 
 def fresh_member(name: str, rng) -> object:
@@ -88,16 +88,13 @@ def compare(model: Path, samples: int, seed: int, nodes: int) -> dict:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("models", nargs="*")
-    parser.add_argument("--samples", type=int, default=40)
-    parser.add_argument("--seed", type=int, default=9100)
+    parser = model_options(__doc__, samples=40, seed=9100)
     parser.add_argument("--nodes", type=int, default=2048)
     args = parser.parse_args(argv)
     models = model_paths(args.models)
-    print("| family | samples | no fallback | same blocks | Hausdorff median / worst "
-          "(% diag) | valid cnn / numerical | cnn time | tracing time | speed-up |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print_table_header(["family", "samples", "no fallback", "same blocks",
+                        "Hausdorff median / worst (% diag)", "valid cnn / numerical",
+                        "cnn time", "tracing time", "speed-up"])
     for model in models:
         compared = compare(model, args.samples, args.seed, args.nodes)
         name, rows = compared["family"], compared["rows"]

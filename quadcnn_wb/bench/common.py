@@ -17,6 +17,22 @@ def parse_options(doc: str, argv, repeat: int):
     return parser.parse_args(argv)
 
 
+def model_options(doc: str, samples: int, seed: int) -> argparse.ArgumentParser:
+    """The options of the benchmarks that run models on fresh family members: the models
+    (default: the shipped ones), how many members, and a seed never used for training."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("models", nargs="*")
+    parser.add_argument("--samples", type=int, default=samples)
+    parser.add_argument("--seed", type=int, default=seed)
+    return parser
+
+
+def print_table_header(columns) -> None:
+    """A markdown table's header and rule (the benchmarks print rows for docs/)."""
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "---|" * len(columns))
+
+
 def bundled_examples():
     """(name, domain) for every bundled example, in name order."""
     for path in sorted(EXAMPLES.glob("*.json")):

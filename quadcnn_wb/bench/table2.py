@@ -11,28 +11,24 @@ the "rays" recipe must beat.
 
 from __future__ import annotations
 
-import argparse
-
 from ..infer.metrics import Confusion
 from ..infer.models import model_paths
 from ..infer.predictor import Predictor
 from ..infer.rays import hint_labels
 from ..learn.dataset import generate
+from .common import model_options, print_table_header
 
 PAPER = {"concave": (0.852, 0.981), "four_hole": (0.821, 0.965)}
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("models", nargs="*")
-    parser.add_argument("--samples", type=int, default=400)
-    parser.add_argument("--seed", type=int, default=9001)
+    parser = model_options(__doc__, samples=400, seed=9001)
     parser.add_argument("--workers", type=int, default=None)
     args = parser.parse_args(argv)
     models = model_paths(args.models)
-    print("| topology | data size | IoU (paper) | accuracy (paper) | IoU (ours) | accuracy (ours) "
-          "| mIoU | all-zeros accuracy | test samples | hints alone IoU / accuracy |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print_table_header(["topology", "data size", "IoU (paper)", "accuracy (paper)",
+                        "IoU (ours)", "accuracy (ours)", "mIoU", "all-zeros accuracy",
+                        "test samples", "hints alone IoU / accuracy"])
     for model in models:
         predictor = Predictor(model, threads=2)
         family = predictor.metadata["family"]

@@ -121,12 +121,18 @@ def bent_rays(rays: Rays, nodes: np.ndarray, theta: np.ndarray, edges: np.ndarra
     return [track[: steps[i] + 1, i] for i in range(r)]
 
 
-def _arm(tree, z, points, heading):
-    """The unit cross arm at each point (inverse-distance mean of the 3 nearest nodes'
-    exp(4it)) closest to its heading."""
+def cross_angle_at(tree, z, points) -> np.ndarray:
+    """One cross direction (radians) at each point: the inverse-distance mean of the 3
+    nearest nodes' z = exp(4it), a quarter of its angle.  Cheap and frame-free (the
+    average is taken in the quartic representation, where the four arms agree)."""
     dist, near = tree.query(points, k=3)
     w = 1.0 / np.maximum(dist, 1e-12)
-    t = np.angle((w * z[near]).sum(axis=1)) / 4.0
+    return np.angle((w * z[near]).sum(axis=1)) / 4.0
+
+
+def _arm(tree, z, points, heading):
+    """The unit cross arm at each point (cross_angle_at) closest to its heading."""
+    t = cross_angle_at(tree, z, points)
     arms = t[:, None] + np.arange(4)[None] * (np.pi / 2)
     dots = np.cos(arms) * heading[:, 0:1] + np.sin(arms) * heading[:, 1:2]
     best = arms[np.arange(len(points)), np.argmax(dots, axis=1)]

@@ -30,6 +30,7 @@ from scipy.spatial import cKDTree
 
 from ..core.curves import winding_numbers
 from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
+from .rays import cross_angle_at
 
 NEIGHBOURS = 12  # m of the paper
 MIN_STEP = 0.35  # a next node must lie this far ahead (element sizes)
@@ -228,9 +229,7 @@ def _stray(line, node_tree, theta, h) -> str:
     if not inner.any():
         return ""
     mid = 0.5 * (pts[:-1] + pts[1:])[inner]
-    dist, near = node_tree.query(mid, k=3)
-    w = 1.0 / np.maximum(dist, 1e-12)
-    t = np.angle((w * np.exp(4j * theta[near])).sum(axis=1)) / 4.0
+    t = cross_angle_at(node_tree, np.exp(4j * theta), mid)
     angle = np.arctan2(seg[inner, 1], seg[inner, 0]) - t
     off = np.abs((angle + np.pi / 4) % (np.pi / 2) - np.pi / 4)  # to the nearest arm
     # over stretches of about an element: single wiggles of the spline do not count
