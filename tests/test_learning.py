@@ -45,7 +45,8 @@ def test_samples_are_deterministic_and_normalised():
     radius = np.hypot(a.x[:, 0], a.x[:, 1])
     assert 0.3 < radius.max() <= 0.5 + 1e-6  # inside the unit-diagonal box's circle
     assert np.allclose(np.hypot(a.x[:, 2], a.x[:, 3]), 1.0, atol=1e-6)
-    assert a.x.shape[1] == 8 and np.all((a.x[:, 4:] >= 0) & (a.x[:, 4:] <= 1))
+    assert a.x.shape[1] == 10 and np.all((a.x[:, 4:] >= 0) & (a.x[:, 4:] <= 1))
+    assert set(np.unique(a.x[:, 8:])) <= {0.0, 1.0}  # the rays' own labels
     angle = np.arctan2(a.x[:, 3], a.x[:, 2])
     assert np.all(angle > -np.pi / 4 - 1e-6) and np.all(angle <= np.pi / 4 + 1e-6)
     assert 0 < a.y.mean() < 0.2 and set(np.unique(a.y)) == {0, 1}
@@ -63,12 +64,16 @@ def test_encoding_carries_the_hints_of_v1_and_v2_with_their_labels():
     nodes = rng.uniform(size=(60, 2)) * [0.5, 1.0]  # tall: the settled pose is a quarter turn
     theta = rng.uniform(-0.7, 0.7, size=60)
     labels = rng.integers(0, 2, size=(60, 2))
-    hints = np.column_stack([labels, rng.random((60, 2))]).astype(float)
+    ray_labels = rng.integers(0, 2, size=(60, 2))
+    hints = np.column_stack([labels, rng.random((60, 2)), ray_labels]).astype(float)
     x, swapped = encode(nodes, theta, hints)
-    assert x.shape == (60, 8) and swapped.any()
+    assert x.shape == (60, 10) and swapped.any()
     assert np.array_equal(x[:, 4:6], swap_labels(labels, swapped))  # paired as labels are
-    assert np.allclose(x[:, 6:], hints[:, 2:], atol=1e-6)  # per-node values stay
+    assert np.allclose(x[:, 6:8], hints[:, 2:4], atol=1e-6)  # per-node values stay
+    assert np.array_equal(x[:, 8:10], swap_labels(ray_labels, swapped))
     assert np.allclose(x[:, :4], encode(nodes, theta)[0])
+    older, _ = encode(nodes, theta, hints[:, :4])  # 8-column data: only one pair
+    assert np.array_equal(older, x[:, :8])
 
 
 def test_encoding_ignores_placement_scale_rotation_and_mirror():
@@ -146,15 +151,15 @@ def test_rays_recipe_reads_the_hints(tiny, tmp_path):
     data, _, _, samples = tiny
     model = tmp_path / "rays.onnx"
     meta = train(data, model, epochs=1, seed=0, recipe="rays", threads=2, progress=False)
-    assert meta["input_shape"] == ["batch", "points", 8] and "rays:" in meta["input"]
+    assert meta["input_shape"] == ["batch", "points", 10] and "rays:" in meta["input"]
     predictor = Predictor(model)
-    assert predictor.inputs == 8
+    assert predictor.inputs == 10
     assert predictor.probabilities(samples[0].x).shape == (len(samples[0].x), 2)
-    with pytest.raises(ModelError, match="takes 8 input columns"):
-        predictor.probabilities(samples[0].x[:, :4])
+    with pytest.raises(ModelError, match="takes 10 input columns"):
+        predictor.probabilities(samples[0].x[:, :8])
     old = tmp_path / "old.npz"  # a data set from before the hints: four columns
     save_dataset(old, [dataclasses.replace(s, x=s.x[:, :4]) for s in samples], {})
-    with pytest.raises(ValueError, match="has 4 input columns, the model takes 8"):
+    with pytest.raises(ValueError, match="has 4 input columns, the model takes 10"):
         train(old, tmp_path / "no.onnx", epochs=1, recipe="rays", progress=False)
 
 

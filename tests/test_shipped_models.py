@@ -10,7 +10,7 @@ import pytest
 
 from quadcnn_wb.infer.metrics import Confusion
 from quadcnn_wb.infer.models import SHIPPED_MODELS, available_models
-from quadcnn_wb.infer.predictor import Predictor
+from quadcnn_wb.infer.predictor import INPUT_WIDTHS, Predictor
 from quadcnn_wb.learn.dataset import make_sample
 from quadcnn_wb.learn.families import family
 
@@ -38,7 +38,7 @@ def test_metadata_is_complete_and_matches_the_file(name):
     assert meta["data"]["seed"] is not None and meta["data"]["seed"] != FRESH_SEED
     assert 0.0 < meta["threshold"] < 1.0
     assert meta["input_shape"] == ["batch", "points", Predictor(entry.path).inputs]
-    assert meta["input_shape"][2] in (4, 8)
+    assert meta["input_shape"][2] in INPUT_WIDTHS
 
 
 @pytest.mark.parametrize("name", REQUIRED)

@@ -4,9 +4,9 @@
 For each model (default: the shipped ones in resources/models), fresh test samples of its
 family are generated with a seed never used for training data, labelled by the numerical
 reference, and compared with the model's prediction (DESIGN.md metric definitions).
-The last column is what the ray hints alone give on the same samples (infer.rays: a
-vector within one element size of a coarse ray heading its way), the baseline a model of
-the "rays" recipe must beat.
+The last column is what the ray hints alone give on the same samples (infer.rays: the
+labels' rule applied to the coarse rays), the baseline a model of the "rays" recipe must
+beat: where it is as good as the model, the rays did the work, not the network.
 """
 
 from __future__ import annotations

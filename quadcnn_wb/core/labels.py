@@ -35,19 +35,30 @@ def resample(points: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray
 
 def frame_labels(mesh: BackgroundMesh, frames: np.ndarray, streamlines) -> np.ndarray:
     """(N, 2) int8 labels for the two frame vectors (v1, v2) of every node."""
-    labels = np.zeros((mesh.n_nodes, 2), dtype=np.int8)
     if not len(streamlines):
-        return labels
+        return np.zeros((mesh.n_nodes, 2), dtype=np.int8)
     walker = MeshWalker(mesh.nodes, mesh.triangles)
-    centroids = mesh.nodes[mesh.triangles].mean(axis=1)
-    tree = cKDTree(centroids)
-    spacing = mesh.element_size / SAMPLES_PER_ELEMENT
-    pts, dirs = zip(*(resample(line.points, spacing) for line in streamlines))
+    tree = cKDTree(mesh.nodes[mesh.triangles].mean(axis=1))
+    return crossed_labels(walker, tree, mesh.element_size, frames,
+                          [line.points for line in streamlines])
+
+
+def crossed_labels(walker: MeshWalker, centroid_tree: cKDTree, h: float, frames: np.ndarray,
+                   polylines) -> np.ndarray:
+    """The rule of frame_labels for any polylines (streamlines, or the coarse rays of
+    infer.rays), on a mesh already prepared for point location (a walker, and a KD-tree
+    of the triangle centroids to start each walk from)."""
+    labels = np.zeros((len(walker.nodes), 2), dtype=np.int8)
+    polylines = [p for p in polylines if len(p) > 1]
+    if not polylines:
+        return labels
+    spacing = h / SAMPLES_PER_ELEMENT
+    pts, dirs = zip(*(resample(p, spacing) for p in polylines))
     pts, dirs = np.concatenate(pts), np.concatenate(dirs)
-    guess = tree.query(pts)[1]
+    guess = centroid_tree.query(pts)[1]
     tri, _, _ = walker.locate(guess, pts)
     inside = tri >= 0
-    nodes = mesh.triangles[tri[inside]]  # (S, 3)
+    nodes = walker.triangles[tri[inside]]  # (S, 3)
     d = np.repeat(dirs[inside][:, None, :], 3, axis=1)  # (S, 3, 2)
     v1, v2 = frames[nodes, 0:2], frames[nodes, 2:4]
     a1 = np.abs((v1 * d).sum(axis=2))

@@ -10,8 +10,8 @@ nothing).  The two outputs are the labels of v1 and v2 of the *encoded* frames: 
 turn made the other vector v1, `swapped` says so and the labels trade places.
 
 Optional per-node hints (infer.rays, the "rays" recipe) follow as further columns; they
-are distances, the same in any pose, except that the first two belong to v1 and v2 and
-trade places with them.
+are the same in any pose, except that some belong to v1 and v2 (rays.PAIRS) and trade
+places with them.
 """
 
 from __future__ import annotations
@@ -46,7 +46,10 @@ def encode(nodes: np.ndarray, theta: np.ndarray,
     settled, quarter = settle(np.column_stack([xy, np.cos(t), np.sin(t)]))
     swapped = swapped ^ quarter
     if hints is not None:
-        settled = np.column_stack([settled, swap_labels(hints, swapped)])
+        from .rays import PAIRS
+
+        pairs = [p for p in PAIRS if max(p) < hints.shape[1]]
+        settled = np.column_stack([settled, swap_labels(hints, swapped, pairs)])
     return settled.astype(np.float32), swapped
 
 
@@ -74,23 +77,25 @@ def settle(x: np.ndarray) -> tuple[np.ndarray, bool]:
     return np.column_stack([xy, c, s]), quarter
 
 
-def swap_labels(labels: np.ndarray, swapped: np.ndarray) -> np.ndarray:
+def swap_labels(labels: np.ndarray, swapped: np.ndarray, pairs=((0, 1),)) -> np.ndarray:
     """Labels between original (v1, v2) order and encoded order (its own inverse).
 
-    Only the first two columns (v1, v2) trade places; further columns stay.
+    The columns of each pair (by default the first two: v1, v2) trade places; the
+    others stay.
     """
     out = np.array(labels, copy=True)
-    out[swapped, :2] = out[swapped][:, 1::-1]
+    for a, b in pairs:
+        out[swapped, a], out[swapped, b] = labels[swapped, b], labels[swapped, a]
     return out
 
 
 def model_input(mesh, field, width: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """encode() for a background mesh and its field, with the ray hints when the model
-    takes 4 + 4 columns."""
+    """encode() for a background mesh and its field, with the first width - 4 ray hints
+    when the model takes more than the paper's 4 columns."""
     hints = None
     if width > 4:
         from .rays import field_rays, ray_features
 
         hints = ray_features(mesh.nodes, mesh.triangles, field.theta, field_rays(field),
-                             mesh.element_size)
+                             mesh.element_size)[:, :width - 4]
     return encode(mesh.nodes, field.theta, hints)

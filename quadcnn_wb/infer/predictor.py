@@ -10,7 +10,7 @@ import numpy as np
 from .encoding import model_input, swap_labels
 
 DEFAULT_THRESHOLD = 0.5
-INPUT_WIDTHS = (4, 8)  # the paper's (x, y, v1x, v1y); with the four ray hints
+INPUT_WIDTHS = (4, 8, 10)  # the paper's (x, y, v1x, v1y); with 4 or all 6 ray hints
 
 
 class ModelError(ValueError):
@@ -37,7 +37,7 @@ class Predictor:
         inputs = self.session.get_inputs()
         if len(inputs) != 1 or inputs[0].shape[-1] not in INPUT_WIDTHS:
             raise ModelError(f"{self.path}: expects {[i.shape for i in inputs]}, not the "
-                             "QuadCNN input [batch, points, 4] (or 8 with the ray hints)")
+                             "QuadCNN input [batch, points, 4] (or 8 or 10 with the ray hints)")
         self.input_name = inputs[0].name
         self.inputs = int(inputs[0].shape[-1])
         self.metadata = load_metadata(self.path)

@@ -21,11 +21,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+SOURCE_SNAP = 1.0  # a ray this close (in element sizes) to another source ends on it
 CLIP = 4.0  # distances beyond this many element sizes all read as "far"
-FEATURES = ("ray distance v1", "ray distance v2", "boundary distance", "source distance")
+FEATURES = ("ray distance v1", "ray distance v2", "boundary distance", "source distance",
+            "ray label v1", "ray label v2")
+PAIRS = ((0, 1), (4, 5))  # hint columns that belong to v1 and v2: they trade places with them
 RAY_ENCODING = ("rays: distance / h to the nearest coarse separatrix ray heading along v1, "
                 "along v2, distance to the boundary / h, to the nearest source / h; each "
-                f"clipped at {CLIP} and divided by it")
+                f"clipped at {CLIP} and divided by it; then the label rule applied to the "
+                "rays (0/1 for v1, v2)")
 
 
 @dataclass(frozen=True)
@@ -33,59 +37,67 @@ class Rays:
     starts: np.ndarray  # (R, 2)
     directions: np.ndarray  # (R, 2) unit
     sources: np.ndarray  # (S, 2) singular points and source corners
+    owner: np.ndarray  # (R,) the source each ray leaves
 
 
 def field_rays(field) -> Rays:
     """Every separatrix of the field's singular points and source corners as a ray."""
-    starts, dirs, points = [], [], []
-    for src in (*field.singularities, *field.corner_sources):
+    starts, dirs, points, owner = [], [], [], []
+    for s, src in enumerate((*field.singularities, *field.corner_sources)):
         points.append(src.xy)
         for d in src.directions:
             starts.append(src.xy)
             dirs.append(d)
+            owner.append(s)
     return Rays(np.array(starts, float).reshape(-1, 2), np.array(dirs, float).reshape(-1, 2),
-                np.array(points, float).reshape(-1, 2))
+                np.array(points, float).reshape(-1, 2), np.array(owner, dtype=np.int64))
 
 
 def boundary_edges(triangles: np.ndarray) -> np.ndarray:
     """(E, 2) node pairs of the edges that belong to one triangle only."""
     edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]],
-                                    triangles[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    return unique[counts == 1]
+                                    triangles[:, [2, 0]]]), axis=1).astype(np.int64)
+    base = int(edges.max()) + 1
+    keys, counts = np.unique(edges[:, 0] * base + edges[:, 1], return_counts=True)
+    single = keys[counts == 1]  # one integer per edge: a 1-D unique, not a row-wise one
+    return np.column_stack([single // base, single % base])
 
 
-def bent_rays(rays: Rays, nodes: np.ndarray, theta: np.ndarray, edges: np.ndarray, h: float,
-              step: float = 1.0) -> list:
+def bent_rays(rays: Rays, nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray,
+              h: float, step: float = 1.0) -> tuple[list, np.ndarray]:
     """Each ray marched along the field (midpoint steps of `step`·h, the cross arm closest
-    to the heading, the field averaged from the 3 nearest nodes), stopped where it
-    crosses the boundary or comes within 0.7 h of another source.
+    to the heading, the field interpolated in the triangle holding the point), stopped
+    where it crosses the boundary or comes within SOURCE_SNAP·h of another source.
 
-    A coarse hint, not a streamline: no triangle walking, no exact snapping, all rays
-    marched together.  Returns one (M, 2) polyline per ray.
+    A coarse hint, not a streamline: steps of a whole element, no exact snapping, all
+    rays marched together.  Returns one (M, 2) polyline per ray and, per ray, the source
+    it ended at (-1: the boundary).
     """
+    return _march(rays, _CrossField(nodes, triangles, theta), nodes, boundary_edges(triangles),
+                  h, step)
+
+
+def _march(rays, field, nodes, edges, h, step=1.0):
     r = len(rays.starts)
     if not r:
-        return []
-    tree = cKDTree(nodes)
+        return [], np.zeros(0, dtype=np.int64)
     boundary_tree = cKDTree(nodes[np.unique(edges)])
-    z = np.exp(4j * theta)
     a, e = nodes[edges[:, 0]], nodes[edges[:, 1]] - nodes[edges[:, 0]]
     reach = step * h + float(np.hypot(*e.T).max())  # farther from the boundary: no crossing
     diag = float(np.hypot(*np.ptp(nodes, axis=0)))
     sources = rays.sources
-    foreign = np.hypot(*(sources[None] - rays.starts[:, None, :]).transpose(2, 0, 1)) \
-        > 1e-9 * diag  # (R, S): the sources a ray may end at
+    foreign = np.arange(len(sources))[None] != rays.owner[:, None]  # (R, S)
     pos, head = rays.starts.copy(), rays.directions.copy()
     alive = np.ones(r, bool)
     steps = np.zeros(r, int)
+    ended_at = np.full(r, -1, dtype=np.int64)
     history = [pos.copy()]
     for count in range(1, int(np.ceil(1.5 * diag / (step * h))) + 1):
         idx = np.nonzero(alive)[0]
         if not len(idx):
             break
-        mid = pos[idx] + 0.5 * step * h * _arm(tree, z, pos[idx], head[idx])
-        new_head = _arm(tree, z, mid, head[idx])
+        mid = pos[idx] + 0.5 * step * h * field.arm(pos[idx], head[idx])
+        new_head = field.arm(mid, head[idx])
         move = step * h * new_head
         frac = np.ones(len(idx))
         hit = np.zeros(len(idx), bool)
@@ -110,15 +122,75 @@ def bent_rays(rays: Rays, nodes: np.ndarray, theta: np.ndarray, edges: np.ndarra
             gap = np.hypot(*(sources[None] - new_pos[:, None, :]).transpose(2, 0, 1))
             gap = np.where(foreign[idx], gap, np.inf)
             k = np.argmin(gap, axis=1)
-            snap = (gap[np.arange(len(idx)), k] < 0.7 * h) & ~stop
+            snap = (gap[np.arange(len(idx)), k] < SOURCE_SNAP * h) & ~stop
             new_pos[snap] = sources[k[snap]]
+            ended_at[idx[snap]] = k[snap]
             stop = stop | snap
         pos[idx], head[idx] = new_pos, new_head
         steps[idx] = count
         alive[idx[stop]] = False
         history.append(pos.copy())
     track = np.stack(history)  # (steps + 1, R, 2); a stopped ray repeats its end
-    return [track[: steps[i] + 1, i] for i in range(r)]
+    return [track[: steps[i] + 1, i] for i in range(r)], ended_at
+
+
+def one_ray_per_separatrix(rays: Rays, lines: list, ended_at: np.ndarray) -> list:
+    """Indices of the rays to keep: a ray from source a that arrives at source b along
+    b's separatrix k *is* that separatrix, so b's own ray along k goes (the tracer's
+    rule, core.tracing: shorter connections claim their two separatrices first).  Two
+    slightly different copies of one connection would widen its band of labels."""
+    length = np.array([np.hypot(*np.diff(p, axis=0).T).sum() for p in lines])
+    arrival = np.full(len(lines), -1, dtype=np.int64)
+    for i in np.nonzero(ended_at >= 0)[0]:
+        b = ended_at[i]
+        own = np.nonzero(rays.owner == b)[0]
+        before = lines[i][-2] if len(lines[i]) > 1 else lines[i][-1]
+        radial = before - rays.sources[b]
+        arrival[i] = own[np.argmax(rays.directions[own] @ radial)] if len(own) else -1
+    taken, keep = set(), []
+    order = np.argsort(length, kind="stable")
+    for i in order:
+        mine = {int(i)} | ({int(arrival[i])} if arrival[i] >= 0 else set())
+        if not mine & taken:
+            keep.append(int(i))
+            taken |= mine
+    for i in order:  # its own separatrix is not yet anyone's: it stays
+        if int(i) not in taken:
+            keep.append(int(i))
+            taken.add(int(i))
+    return sorted(keep)
+
+
+class _CrossField:
+    """The cross field between the nodes: z = exp(4it) interpolated linearly in the
+    triangle holding a point (the tracer's interpolation), found by walking from the
+    triangle with the nearest centroid; points off the mesh take cross_angle_at."""
+
+    def __init__(self, nodes, triangles, theta):
+        from ..core.meshwalk import MeshWalker
+
+        self.tree = cKDTree(nodes)
+        self.centroids = cKDTree(nodes[triangles].mean(axis=1))
+        self.walker = MeshWalker(nodes, triangles)
+        self.triangles = triangles
+        self.z = np.exp(4j * theta)
+
+    def angle(self, points):
+        tri, bary, _ = self.walker.locate(self.centroids.query(points)[1], points)
+        inside = tri >= 0
+        out = np.empty(len(points))
+        out[inside] = np.angle((self.z[self.triangles[tri[inside]]] * bary[inside])
+                               .sum(axis=1)) / 4.0
+        if not inside.all():
+            out[~inside] = cross_angle_at(self.tree, self.z, points[~inside])
+        return out
+
+    def arm(self, points, heading):
+        """The unit cross arm at each point closest to its heading."""
+        arms = self.angle(points)[:, None] + np.arange(4)[None] * (np.pi / 2)
+        dots = np.cos(arms) * heading[:, 0:1] + np.sin(arms) * heading[:, 1:2]
+        best = arms[np.arange(len(points)), np.argmax(dots, axis=1)]
+        return np.column_stack([np.cos(best), np.sin(best)])
 
 
 def cross_angle_at(tree, z, points) -> np.ndarray:
@@ -130,23 +202,20 @@ def cross_angle_at(tree, z, points) -> np.ndarray:
     return np.angle((w * z[near]).sum(axis=1)) / 4.0
 
 
-def _arm(tree, z, points, heading):
-    """The unit cross arm at each point (cross_angle_at) closest to its heading."""
-    t = cross_angle_at(tree, z, points)
-    arms = t[:, None] + np.arange(4)[None] * (np.pi / 2)
-    dots = np.cos(arms) * heading[:, 0:1] + np.sin(arms) * heading[:, 1:2]
-    best = arms[np.arange(len(points)), np.argmax(dots, axis=1)]
-    return np.column_stack([np.cos(best), np.sin(best)])
-
-
 def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, rays: Rays,
                  h: float) -> np.ndarray:
-    """(N, 4) float32 hints in [0, 1] (see FEATURES), 0 meaning "on it"."""
-    from ..core.labels import resample
+    """(N, 6) float32 hints in [0, 1] (see FEATURES): distances, 0 meaning "on it", then
+    the labels' own rule applied to the rays (1: a ray crosses a triangle of the node
+    heading along that vector)."""
+    from ..core.labels import crossed_labels, resample
 
-    out = np.ones((len(nodes), 4))
+    out = np.ones((len(nodes), len(FEATURES)))
+    out[:, 4:] = 0.0
+    field = _CrossField(nodes, triangles, theta)
     edges = boundary_edges(triangles)
-    lines = [p for p in bent_rays(rays, nodes, theta, edges, h) if len(p) > 1]
+    tracks, ended_at = _march(rays, field, nodes, edges, h)
+    lines = [tracks[i] for i in one_ray_per_separatrix(rays, tracks, ended_at)
+             if len(tracks[i]) > 1]
     if lines:
         pts, dirs = zip(*(resample(p, 0.25 * h) for p in lines))
         pts, dirs = np.concatenate(pts), np.concatenate(dirs)
@@ -160,6 +229,8 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
         for column, aligned in ((0, with_v1), (1, ~with_v1)):
             best = np.where(found & aligned, dist, np.inf).min(axis=1)
             out[:, column] = np.minimum(best / h, CLIP) / CLIP
+        frames = np.column_stack([np.cos(theta), np.sin(theta), -np.sin(theta), np.cos(theta)])
+        out[:, 4:] = crossed_labels(field.walker, field.centroids, h, frames, lines)
     boundary = np.unique(edges)
     out[:, 2] = np.minimum(cKDTree(nodes[boundary]).query(nodes)[0] / h, CLIP) / CLIP
     if len(rays.sources):
@@ -168,6 +239,9 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
 
 
 def hint_labels(x: np.ndarray) -> np.ndarray:
-    """(N, 2) labels the hints alone give (a vector within one element size of a ray
-    heading its way): the baseline a "rays" model has to beat.  x: encoded, 8 columns."""
+    """(N, 2) labels the hints alone give: the crossed-triangle rule on the rays (x with
+    10 columns), or for older 8-column data a vector within one element size of a ray
+    heading its way.  The baseline a "rays" model has to beat.  x: encoded."""
+    if x.shape[1] >= 10:
+        return np.rint(x[:, 8:10]).astype(np.uint8)
     return (x[:, 4:6] * CLIP < 1.0).astype(np.uint8)

@@ -4,11 +4,11 @@
 the generator seeded with (S, i), so the data set is the same whatever the number of
 workers.  A sample is kept only if its field has the family's singular points and its
 streamlines give a valid four-sided partition; the others are dropped and counted by
-reason.  Stored as one .npz: inputs `x` (points, 8) float32 — the paper's four columns
-then the four ray hints of infer.rays, so one data set serves both kinds of model (a
+reason.  Stored as one .npz: inputs `x` (points, 10) float32 — the paper's four columns
+then the six ray hints of infer.rays, so one data set serves every kind of model (a
 model reads the first columns it takes) —, labels `y` (points, 2) uint8, `offsets`
 (samples + 1) into them, and a JSON `meta`.  The hints are computed before the smooth
-deformation and bent with the sample (they are distances in element sizes).
+deformation and bent with the sample (distances in element sizes, and labels).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ NODE_SPREAD = 0.03  # node targets vary by this share around --nodes
 
 @dataclass
 class Sample:
-    x: np.ndarray  # (N, 8) float32 (older data sets: (N, 4), no hints)
+    x: np.ndarray  # (N, 10) float32 (older data sets: (N, 4) or (N, 8))
     y: np.ndarray  # (N, 2) uint8
 
 
@@ -88,8 +88,9 @@ def make_sample(source, seed: int, index: int, nodes: int = 2048):
     hints = ray_features(mesh.nodes, mesh.triangles, ref.field.theta, field_rays(ref.field),
                          mesh.element_size)
     nodes_xy, theta, carried = smooth_deformation(
-        mesh.nodes, ref.field.theta, np.column_stack([ref.labels, hints[:, :2]]), rng)
-    hints = np.column_stack([carried[:, 2:], hints[:, 2:]])
+        mesh.nodes, ref.field.theta,
+        np.column_stack([ref.labels, hints[:, 0:2], hints[:, 4:6]]), rng)
+    hints = np.column_stack([carried[:, 2:4], hints[:, 2:4], carried[:, 4:6]])
     x, swapped = encode(nodes_xy, theta, hints)
     labels = swap_labels(carried[:, :2], swapped)
     return Sample(x=x, y=np.rint(labels).astype(np.uint8)), None
@@ -151,7 +152,7 @@ def _progress(done: int, total: int, started: float) -> None:
 
 
 def save_dataset(path, samples, meta: dict) -> None:
-    x = np.concatenate([s.x for s in samples]) if samples else np.zeros((0, 8), np.float32)
+    x = np.concatenate([s.x for s in samples]) if samples else np.zeros((0, 10), np.float32)
     y = np.concatenate([s.y for s in samples]) if samples else np.zeros((0, 2), np.uint8)
     offsets = np.concatenate([[0], np.cumsum([len(s.x) for s in samples])]).astype(np.int64)
     meta = {**meta, "encoding": ENCODING, "hints": RAY_ENCODING, "samples": len(samples)}

@@ -24,7 +24,8 @@ Options beyond Table 1 (all off by default, so QuadCNN() is the paper's network;
 "fast" training recipe turns them on, see learn.train): Fourier features of the
 positions, keypoint pooling (soft-argmax locations the head sees offsets to), a mean-pooled
 half of the global feature, a dynamic graph for stages 2 and 3 (DGCNN), lighter widths,
-and `inputs=8`: the four ray hints of infer.rays after the paper's four columns.
+and `inputs=8` or `10`: the first four or all six ray hints of infer.rays after the
+paper's four columns.
 kNN uses topk on minus the squared distance from batched matrix products (no cdist, no
 Python loop over points), so any number of points N works, in training and in ONNX.
 """

@@ -7,11 +7,12 @@ Recipes:
   AdamW (1e-3, one-cycle schedule), and a lighter network (global feature 256, head
   128-128-64, dropout 0.1, Fourier features of the positions): a third of the cost per
   step, so three times the steps in a CPU session, which is what decides here.
-- "rays": the fast recipe's optimiser on a smaller network that also reads the ray hints
-  (infer.rays: where coarse field-following rays from the singular points run).  The
-  hints place the bands; the network learns where they are off (curving streamlines,
-  rays that end early, the exact crossed-triangle rule).  No ridge targets: the hints
-  already tell every point which way the band lies.
+- "rays": the fast recipe's optimiser on a smaller network that also reads the six ray
+  hints (infer.rays: where coarse field-following rays from the singular points run, and
+  the labels' rule applied to them).  The hints place the bands; the network learns
+  where they are off (rays that drift, end early or late).  No ridge targets: the hints
+  already tell every point which way the band lies.  (Models of the first rays recipe
+  read only the four distance hints: 8 columns.)
 80/20 split by the seed; the model with the best validation IoU is kept (early stop after
 `patience` epochs without improvement), checkpointed every epoch, exported to ONNX (opset
 17, dynamic batch and point count) with a metadata JSON beside it.
@@ -45,7 +46,7 @@ RECIPES = {
                        "head": [128, 128, 64], "keypoints": 32}},
     "rays": {"optimizer": "adamw", "lr": 2e-3, "batch": 4, "pos_weight": "auto",
              "schedule": "onecycle", "weight_decay": 1e-4, "ridge": False,
-             "model": {"inputs": 8, "dropout": 0.1, "octaves": 2, "global_width": 128,
+             "model": {"inputs": 10, "dropout": 0.1, "octaves": 2, "global_width": 128,
                        "head": [64, 64, 32]}},
 }
 
