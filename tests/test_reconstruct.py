@@ -64,13 +64,14 @@ def test_a_line_across_the_field_is_not_trusted():
     """The verification that catches a walk gone over to a neighbouring band: traced
     streamlines pass it, a line cutting across the crosses does not."""
     from quadcnn_wb.core.tracing import Endpoint, Streamline
+    from quadcnn_wb.infer.rays import CrossField
     from quadcnn_wb.infer.reconstruct import _stray
 
     ref = reference("four_hole")
     h = ref.mesh.element_size
-    tree = cKDTree(ref.mesh.nodes)
+    field = CrossField(ref.mesh.nodes, ref.mesh.triangles, ref.field.theta)
     for line in ref.streamlines:
-        assert _stray(line, tree, ref.field.theta, h) == ""
+        assert _stray(line, field, h) == ""
     long = max(ref.streamlines, key=lambda line: line.length)
     a, b = long.points[0], long.points[-1]
     # the same ends, but a detour that leaves at 45° to the straight run
@@ -79,19 +80,20 @@ def test_a_line_across_the_field_is_not_trusted():
     bent = np.vstack([np.linspace(a, mid, 30), np.linspace(mid, b, 30)[1:]])
     detour = Streamline(points=bent, start=Endpoint("boundary"), end=Endpoint("boundary"),
                         capped=False, start_direction=None)
-    assert "across the field" in _stray(detour, tree, ref.field.theta, h)
+    assert "across the field" in _stray(detour, field, h)
 
 
 def test_rebuilt_four_hole_partition_from_reference_labels():
     """Dense streamlines a few elements apart (four holes, 16 singular points): perfect
-    labels give a four-sided partition with almost every walk trusted.  (Not yet the
-    reference's blocks: 2 of its 20 connections between singular points pass through
-    places where several bands meet, and the walks end on the boundary instead.)"""
+    labels give the reference's own blocks.  Hopping to the best-aligned labelled vector
+    alone drifts over to the next band where bands run two elements apart (69 blocks,
+    2 of the 20 connections between singular points lost): a candidate off the line
+    ahead pays for it (LATERAL)."""
     ref = reference("four_hole")
     lines, problems = reconstruct_streamlines(ref.domain, ref.mesh, ref.field, ref.labels)
-    assert len(problems) <= 2, problems
+    assert not problems
     rebuilt = build_partition(ref.domain, lines, ref.mesh.element_size)
     traced = build_partition(ref.domain, ref.streamlines, ref.mesh.element_size)
-    assert len(traced.blocks) <= len(rebuilt.blocks) <= 1.5 * len(traced.blocks)
+    assert len(rebuilt.blocks) == len(traced.blocks)
     connections = sum(line.end.kind == "singularity" for line in lines)
-    assert connections >= sum(line.end.kind == "singularity" for line in ref.streamlines) - 2
+    assert connections == sum(line.end.kind == "singularity" for line in ref.streamlines)

@@ -73,7 +73,7 @@ def bent_rays(rays: Rays, nodes: np.ndarray, triangles: np.ndarray, theta: np.nd
     rays marched together.  Returns one (M, 2) polyline per ray and, per ray, the source
     it ended at (-1: the boundary).
     """
-    return _march(rays, _CrossField(nodes, triangles, theta), nodes, boundary_edges(triangles),
+    return _march(rays, CrossField(nodes, triangles, theta), nodes, boundary_edges(triangles),
                   h, step)
 
 
@@ -161,7 +161,7 @@ def one_ray_per_separatrix(rays: Rays, lines: list, ended_at: np.ndarray) -> lis
     return sorted(keep)
 
 
-class _CrossField:
+class CrossField:
     """The cross field between the nodes: z = exp(4it) interpolated linearly in the
     triangle holding a point (the tracer's interpolation), found by walking from the
     triangle with the nearest centroid; points off the mesh take cross_angle_at."""
@@ -211,7 +211,7 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
 
     out = np.ones((len(nodes), len(FEATURES)))
     out[:, 4:] = 0.0
-    field = _CrossField(nodes, triangles, theta)
+    field = CrossField(nodes, triangles, theta)
     edges = boundary_edges(triangles)
     tracks, ended_at = _march(rays, field, nodes, edges, h)
     lines = [tracks[i] for i in one_ray_per_separatrix(rays, tracks, ended_at)

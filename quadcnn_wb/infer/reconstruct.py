@@ -30,14 +30,17 @@ from scipy.spatial import cKDTree
 
 from ..core.curves import winding_numbers
 from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
-from .rays import cross_angle_at
+from .rays import CrossField
 
 NEIGHBOURS = 12  # m of the paper
 MIN_STEP = 0.35  # a next node must lie this far ahead (element sizes)
 MAX_STEP = 2.0  # and no farther than this (element sizes): a longer jump crosses a gap
 MAX_TURN = math.radians(50)  # a step turning more than this counts as turning back
 SMOOTHING_PASSES = 5
-MAX_STRAY = 20.0  # degrees a rebuilt line may run across the field (over an element)
+MAX_STRAY = 25.0  # degrees a rebuilt line may run across the field (over an element)
+LEAVE = 0.75  # element sizes walked straight along the separatrix before the first hop
+LATERAL = 0.3  # score penalty per element size a candidate lies off the heading's line
+BAND_HALF_WIDTH = 1.0  # nodes this far across the heading (element sizes) form its band
 
 
 @dataclass(frozen=True)
@@ -82,9 +85,12 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, sources, boundary
     start_dir = np.array([np.asarray(s[1], dtype=float) for s in sources]).reshape(-1, 2)
     origins = [s[3] for s in sources]
     snap = _SnapTargets(targets, target_kind, field, origins)
-    current, heading = start.copy(), start_dir.copy()
-    paths = [[p.copy()] for p in start]
-    travelled = np.zeros(r)
+    # The first stretch runs straight along the separatrix (as _finish draws it anyway):
+    # right at a singular point the nodes' crosses turn fast, and the first hop's vector
+    # may lie more than MAX_TURN off the separatrix although the walk is fine.
+    current, heading = start + LEAVE * h * start_dir, start_dir.copy()
+    paths = [[p.copy(), q.copy()] for p, q in zip(start, current)]
+    travelled = np.full(r, LEAVE * h)
     used = np.zeros((r, len(vectors)), dtype=bool)
     walks: list = [None] * r
     active = np.arange(r)
@@ -108,25 +114,28 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, sources, boundary
         offsets = vectors.points[idx] - current[active, None, :]
         ahead = np.einsum("akc,ac->ak", offsets, heading[active])
         ok = (ahead >= MIN_STEP * h) & (dist <= MAX_STEP * h) & ~used[active[:, None], idx]
-        stalled = ~ok.any(axis=1)
-        for i in active[stalled]:
+        vec = vectors.vectors[idx]  # (A, k, 2)
+        along = np.einsum("akc,ac->ak", vec, heading[active])
+        # A vector more than MAX_TURN off the heading belongs to a crossing band (the
+        # lateral penalty below could otherwise prefer it to an aligned one off the line).
+        straight = ok & (np.abs(along) >= math.cos(MAX_TURN))
+        stalled = ~straight.any(axis=1)
+        for i, turned in zip(active[stalled], ok[stalled].any(axis=1)):
             if not boundary_end(i):
-                walks[i] = Walk(None, "stalled: no labelled vector ahead")
+                x, y = current[i]
+                walks[i] = Walk(None, f"turned back at ({x:.6g}, {y:.6g})" if turned
+                                else "stalled: no labelled vector ahead")
         rows, active = np.nonzero(~stalled)[0], active[~stalled]
         if not len(active):
             break
-        vec = vectors.vectors[idx[rows]]  # (A, k, 2)
-        along = np.einsum("akc,ac->ak", vec, heading[active])
-        score = np.where(ok[rows], np.abs(along) - 0.02 * dist[rows] / h, -np.inf)
+        side = np.abs(offsets[rows, :, 0] * heading[active, None, 1]
+                      - offsets[rows, :, 1] * heading[active, None, 0])
+        score = np.where(straight[rows], np.abs(along[rows]) - 0.02 * dist[rows] / h
+                         - LATERAL * side / h, -np.inf)
         best = np.argmax(score, axis=1)
-        pick = np.arange(len(active))
         chosen = idx[rows, best]
-        cosine = along[pick, best]
-        new_heading = vec[pick, best] * np.where(cosine >= 0, 1.0, -1.0)[:, None]
-        turned = np.arccos(np.minimum(1.0, np.abs(cosine))) > MAX_TURN
-        for i in active[turned]:
-            walks[i] = Walk(None, "turned back")
-        active, chosen, new_heading = active[~turned], chosen[~turned], new_heading[~turned]
+        cosine = along[rows, best]
+        new_heading = vec[rows, best] * np.where(cosine >= 0, 1.0, -1.0)[:, None]
         used[active, chosen] = True
         target = vectors.points[chosen]
         travelled[active] += np.hypot(*(target - current[active]).T)
@@ -214,7 +223,7 @@ class _SnapTargets:
         return out
 
 
-def _stray(line, node_tree, theta, h) -> str:
+def _stray(line, field_between, h) -> str:
     """Why a rebuilt line cannot be a streamline, or "": it must run along the field.
 
     Away from its ends (where the field turns fast around a singular point) a streamline
@@ -229,7 +238,7 @@ def _stray(line, node_tree, theta, h) -> str:
     if not inner.any():
         return ""
     mid = 0.5 * (pts[:-1] + pts[1:])[inner]
-    t = cross_angle_at(node_tree, np.exp(4j * theta), mid)
+    t = field_between.angle(mid)
     angle = np.arctan2(seg[inner, 1], seg[inner, 0]) - t
     off = np.abs((angle + np.pi / 4) % (np.pi / 2) - np.pi / 4)  # to the nearest arm
     # over stretches of about an element: single wiggles of the spline do not count
@@ -249,7 +258,7 @@ def _band_centres(vectors, points, headings, h):
     the drift carries a walk over to a neighbouring streamline.
     """
     k = min(40, len(vectors))  # more than a band holds within one element
-    dist, idx = vectors.tree.query(points, k=k, distance_upper_bound=1.0 * h)
+    dist, idx = vectors.tree.query(points, k=k, distance_upper_bound=BAND_HALF_WIDTH * h)
     dist, idx = dist.reshape(len(points), k), idx.reshape(len(points), k)
     found = idx < len(vectors)
     safe = np.where(found, idx, 0)
@@ -352,14 +361,13 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
     boundary_ids = mesh.boundary_nodes
     boundary_tree = cKDTree(mesh.nodes[boundary_ids])
     targets, target_kind = _snap_targets(mesh, field)
-    node_tree = cKDTree(mesh.nodes)
+    field_between = CrossField(mesh.nodes, mesh.triangles, field.theta)
     lines, failed, problems = [], [], []
     walks = walk_labels(domain, mesh, field, vectors, sources, boundary_tree, boundary_ids,
                         targets, target_kind)
     for source, walk in zip(sources, walks):
         xy, direction, _, origin = source
-        problem = walk.problem if walk.line is None else _stray(walk.line, node_tree,
-                                                                  field.theta, h)
+        problem = walk.problem if walk.line is None else _stray(walk.line, field_between, h)
         if problem:
             failed.append(source)
             problems.append((f"{origin.kind} {origin.index} branch {origin.branch}",
