@@ -90,15 +90,15 @@ learning-figures: setup
 # The exact commands behind resources/models (see docs/learning.md); needs the train extra.
 models: setup
 	@mkdir -p data
-	$(PY) -m quadcnn_wb dataset concave -n 2000 --seed 1 --workers 2 -o data/rays_concave.npz
-	$(PY) -m quadcnn_wb dataset four_hole -n 2000 --seed 2 --workers 2 -o data/rays_four_hole.npz
-	$(PY) -m quadcnn_wb dataset semicircle -n 1200 --seed 3 --workers 2 -o data/rays_semicircle.npz
-	$(PY) -m quadcnn_wb train data/rays_concave.npz -o resources/models/concave.onnx --recipe rays \
-	    --epochs 10 --minutes 45 --threads 1 --seed 0
-	$(PY) -m quadcnn_wb train data/rays_four_hole.npz -o resources/models/four_hole.onnx \
+	$(PY) -m quadcnn_wb dataset concave -n 2000 --seed 1 --workers 2 -o data/concave.npz
+	$(PY) -m quadcnn_wb dataset four_hole -n 2000 --seed 2 --workers 2 -o data/four_hole.npz
+	$(PY) -m quadcnn_wb dataset semicircle -n 1200 --seed 3 --workers 2 -o data/semicircle.npz
+	$(PY) -m quadcnn_wb train data/concave.npz -o resources/models/concave.onnx --recipe rays \
+	    --epochs 5 --minutes 30 --threads 1 --seed 0
+	$(PY) -m quadcnn_wb train data/four_hole.npz -o resources/models/four_hole.onnx \
 	    --recipe rays --epochs 10 --minutes 45 --threads 1 --seed 0
-	$(PY) -m quadcnn_wb train data/rays_semicircle.npz -o resources/models/semicircle.onnx \
-	    --recipe rays --epochs 10 --minutes 40 --threads 1 --seed 0
+	$(PY) -m quadcnn_wb train data/semicircle.npz -o resources/models/semicircle.onnx \
+	    --recipe rays --epochs 10 --minutes 30 --threads 1 --seed 0
 
 robustness: setup
 	$(PY) -m quadcnn_wb.bench.robustness -n 500 --seed 0

@@ -18,7 +18,7 @@ from ..core.domain import load_domain
 from ..core.reference import numerical_reference
 from ..infer.encoding import model_input
 from ..infer.models import model_paths
-from ..infer.predictor import Predictor
+from ..infer.predictor import INPUT_WIDTHS, Predictor
 from .common import EXAMPLES
 
 
@@ -38,15 +38,16 @@ def main(argv=None) -> int:
         models = [Path(tempfile.mkdtemp()) / "untrained.onnx"]
         export_onnx(QuadCNN(), models[0])
     ref = numerical_reference(load_domain(EXAMPLES / "four_hole.json"), labels=False)
-    x, _ = model_input(ref.mesh, ref.field, width=8)
+    width = max(INPUT_WIDTHS)
+    x, _ = model_input(ref.mesh, ref.field, width=width)
     print(f"one sample of {len(x)} points (four_hole)")
     hint_times = []
     for _ in range(args.repeat):
         start = time.perf_counter()
-        model_input(ref.mesh, ref.field, width=8)
+        model_input(ref.mesh, ref.field, width=width)
         hint_times.append(time.perf_counter() - start)
     print(f"{'encoding with ray hints':<24}            median "
-          f"{statistics.median(hint_times) * 1e3:6.1f} ms (models of 8 input columns)")
+          f"{statistics.median(hint_times) * 1e3:6.1f} ms (models of {width} input columns)")
     for model in models:
         for threads in (1, 2):
             predictor = Predictor(model, threads=threads)
