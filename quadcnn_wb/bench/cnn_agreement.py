@@ -7,7 +7,9 @@ the same background mesh and field: once with numerical tracing, once from the m
 labels.  Printed per family: the share rebuilt with no fallback at all (over all members,
 and over those whose numerical partition is valid: where tracing itself gives no block
 structure, the cnn path's partition fails too and everything is retraced), the mean share
-of streamlines rebuilt from labels (the rest traced numerically), the share whose
+of walks the checks rejected (each traced numerically instead), the mean share of
+streamlines in the final mesh rebuilt from labels (less when a partition failed and
+everything was retraced), the share whose
 block structure (blocks, partition edges and vertices) equals the numerical one, the
 symmetric Hausdorff distance between the two sets of streamlines as a share of the
 bounding-box diagonal (median and worst), the share of valid meshes on each path, and the
@@ -95,7 +97,16 @@ def label_source(model: Path, labels: str):
 
 def compare(model: Path, samples: int, seed: int, nodes: int, labels: str = "model") -> dict:
     name = Predictor(model).metadata["family"]
-    source = label_source(model, labels)
+    rebuild = label_source(model, labels)
+    walks = {}
+
+    def source(domain, background, field):  # counts the walks the checks rejected
+        lines, problems = rebuild(domain, background, field)
+        total = sum(len(src.directions)
+                    for src in (*field.singularities, *field.corner_sources))
+        walks.update(total=total, rejected=len(problems))
+        return lines, problems
+
     rng = np.random.default_rng(seed)
     rows = []
     for _ in range(samples):
@@ -107,6 +118,7 @@ def compare(model: Path, samples: int, seed: int, nodes: int, labels: str = "mod
         rows.append({
             "no_fallback": not learned.fallback,
             "rebuilt": 1.0 - len(learned.fallback) / max(len(learned.streamlines), 1),
+            "walks": walks["rejected"] / max(walks["total"], 1),
             "same_structure": structure(learned) == structure(numerical),
             "hausdorff": hausdorff_share(learned.streamlines, numerical.streamlines, diagonal),
             "valid_cnn": learned.structured,
@@ -127,7 +139,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     models = model_paths(args.models)
     print_table_header(["family", "samples", "no fallback (all / numerical valid)",
-                        "lines rebuilt", "same blocks",
+                        "walks rejected", "lines rebuilt", "same blocks",
                         "Hausdorff median / worst (% diag)", "valid cnn / numerical",
                         "cnn time", "tracing time", "speed-up"])
     for model in models:
@@ -143,6 +155,7 @@ def main(argv=None) -> int:
                  if args.labels == "model" else f"– | {1000 * t_num:.1f} ms | –")
         print(f"| {name} | {len(rows)} | {share['no_fallback']:.0%} / "
               f"{np.mean(valid) if valid else 0:.0%} of {len(valid)} | "
+              f"{np.mean([r['walks'] for r in rows]):.1%} | "
               f"{np.mean([r['rebuilt'] for r in rows]):.1%} | "
               f"{share['same_structure']:.0%} | {np.median(h):.2f} / {h.max():.2f} | "
               f"{share['valid_cnn']:.0%} / {share['valid_numerical']:.0%} | {times} |")
