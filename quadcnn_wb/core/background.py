@@ -10,11 +10,13 @@ parameter and tangent, because the frame field is aligned with that tangent.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import gmsh
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .curves import Arc, cross2
 from .domain import Domain
@@ -51,6 +53,24 @@ class BackgroundMesh:
     @property
     def n_nodes(self) -> int:
         return len(self.nodes)
+
+    # Point location on this mesh, built once: tracing, labels, cuts, the ray hints and
+    # the reconstruction all walk the same triangles (a copy made with
+    # dataclasses.replace, e.g. jittered nodes, builds its own).
+    @functools.cached_property
+    def walker(self):
+        from .meshwalk import MeshWalker
+
+        return MeshWalker(self.nodes, self.triangles)
+
+    @functools.cached_property
+    def centroid_tree(self) -> cKDTree:
+        """KD-tree of the triangle centroids: where a walk to a far point starts."""
+        return cKDTree(self.nodes[self.triangles].mean(axis=1))
+
+    @functools.cached_property
+    def node_tree(self) -> cKDTree:
+        return cKDTree(self.nodes)
 
     def to_json(self) -> dict:
         """The `background` output of DESIGN.md."""

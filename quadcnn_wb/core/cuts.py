@@ -12,7 +12,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .meshwalk import MeshWalker
 from .tracing import Endpoint, integrate
 
 
@@ -54,7 +53,7 @@ def connecting_cuts(domain, mesh, field, streamlines) -> list:
         if not loose:
             break
         if walker is None:
-            walker = MeshWalker(mesh.nodes, mesh.triangles)
+            walker = mesh.walker
         cut = _cut_from(domain, mesh, field, loose[0], walker)
         k = len(lines) + len(cuts)
         parts.union(("line", k), ("loop", loose[0]))

@@ -37,9 +37,7 @@ def frame_labels(mesh: BackgroundMesh, frames: np.ndarray, streamlines) -> np.nd
     """(N, 2) int8 labels for the two frame vectors (v1, v2) of every node."""
     if not len(streamlines):
         return np.zeros((mesh.n_nodes, 2), dtype=np.int8)
-    walker = MeshWalker(mesh.nodes, mesh.triangles)
-    tree = cKDTree(mesh.nodes[mesh.triangles].mean(axis=1))
-    return crossed_labels(walker, tree, mesh.element_size, frames,
+    return crossed_labels(mesh.walker, mesh.centroid_tree, mesh.element_size, frames,
                           [line.points for line in streamlines])
 
 

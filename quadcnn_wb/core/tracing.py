@@ -21,7 +21,6 @@ from scipy.spatial import cKDTree
 from .background import BackgroundMesh
 from .domain import Domain
 from .framefield import FrameField
-from .meshwalk import MeshWalker
 
 STEP = 0.25  # integration step, in element sizes
 SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes
@@ -130,7 +129,7 @@ def _rotate_to(theta: np.ndarray, d: np.ndarray) -> np.ndarray:
 
 def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) -> tuple:
     """Every separatrix and concave-corner streamline, one line per separatrix."""
-    walker = MeshWalker(mesh.nodes, mesh.triangles)
+    walker = mesh.walker
     sources = _sources(mesh, field_, walker, mesh.element_size)
     if not sources:
         return ()
@@ -142,7 +141,7 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
     """Trace from each (start xy, unit direction, start triangle, start Endpoint) source."""
     h = mesh.element_size
     step = STEP * h
-    walker = walker or MeshWalker(mesh.nodes, mesh.triangles)
+    walker = walker or mesh.walker
     boundary = _BoundaryIndex(domain, mesh)
     z = field_.z
     starts = np.array([s[0] for s in sources])

@@ -94,8 +94,8 @@ def model_input(mesh, field, width: int = 4) -> tuple[np.ndarray, np.ndarray]:
     when the model takes more than the paper's 4 columns."""
     hints = None
     if width > 4:
-        from .rays import field_rays, ray_features
+        from .rays import CrossField, field_rays, ray_features
 
         hints = ray_features(mesh.nodes, mesh.triangles, field.theta, field_rays(field),
-                             mesh.element_size)[:, :width - 4]
+                             mesh.element_size, CrossField.on(mesh, field.theta))[:, :width - 4]
     return encode(mesh.nodes, field.theta, hints)

@@ -170,14 +170,21 @@ class CrossField:
     triangle holding a point (the tracer's interpolation), found by walking from the
     triangle with the nearest centroid; points off the mesh take cross_angle_at."""
 
-    def __init__(self, nodes, triangles, theta):
+    def __init__(self, nodes, triangles, theta, walker=None, centroids=None, tree=None):
         from ..core.meshwalk import MeshWalker
 
-        self.tree = cKDTree(nodes)
-        self.centroids = cKDTree(nodes[triangles].mean(axis=1))
-        self.walker = MeshWalker(nodes, triangles)
+        self.tree = tree if tree is not None else cKDTree(nodes)
+        self.centroids = centroids if centroids is not None \
+            else cKDTree(nodes[triangles].mean(axis=1))
+        self.walker = walker if walker is not None else MeshWalker(nodes, triangles)
         self.triangles = triangles
         self.z = np.exp(4j * theta)
+
+    @classmethod
+    def on(cls, mesh, theta) -> CrossField:
+        """On a BackgroundMesh, sharing its walker and trees (built once per mesh)."""
+        return cls(mesh.nodes, mesh.triangles, theta, mesh.walker, mesh.centroid_tree,
+                   mesh.node_tree)
 
     def angle(self, points):
         tri, bary, _ = self.walker.locate(self.centroids.query(points)[1], points)
@@ -207,15 +214,16 @@ def cross_angle_at(tree, z, points) -> np.ndarray:
 
 
 def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, rays: Rays,
-                 h: float) -> np.ndarray:
+                 h: float, field: CrossField | None = None) -> np.ndarray:
     """(N, 6) float32 hints in [0, 1] (see FEATURES): distances, 0 meaning "on it", then
     the labels' own rule applied to the rays (1: a ray crosses a triangle of the node
-    heading along that vector)."""
+    heading along that vector).  `field`: the cross field on these nodes, when the caller
+    has one (CrossField.on a mesh shares its point location)."""
     from ..core.labels import crossed_labels, resample
 
     out = np.ones((len(nodes), len(FEATURES)))
     out[:, 4:] = 0.0
-    field = CrossField(nodes, triangles, theta)
+    field = field or CrossField(nodes, triangles, theta)
     edges = boundary_edges(triangles)
     tracks, ended_at = _march(rays, field, nodes, edges, h)
     lines = [tracks[i] for i in one_ray_per_separatrix(rays, tracks, ended_at)

@@ -351,17 +351,16 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
 
     Returns (streamlines, problems): each problem is (source description, reason).
     """
-    from ..core.meshwalk import MeshWalker
     from ..core.tracing import _one_line_per_separatrix, _snap_targets, _sources, integrate
 
     h = mesh.element_size
-    walker = MeshWalker(mesh.nodes, mesh.triangles)
+    walker = mesh.walker
     sources = _sources(mesh, field, walker, h)
     vectors = LabelledVectors(mesh.nodes, field.frames, labels)
     boundary_ids = mesh.boundary_nodes
     boundary_tree = cKDTree(mesh.nodes[boundary_ids])
     targets, target_kind = _snap_targets(mesh, field)
-    field_between = CrossField(mesh.nodes, mesh.triangles, field.theta)
+    field_between = CrossField.on(mesh, field.theta)
     lines, failed, problems = [], [], []
     walks = walk_labels(domain, mesh, field, vectors, sources, boundary_tree, boundary_ids,
                         targets, target_kind)

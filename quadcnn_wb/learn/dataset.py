@@ -31,7 +31,7 @@ from ..core.partition import PartitionError, build_partition
 from ..core.reference import numerical_reference
 from ..core.transform import similarity, transform_domain_json
 from ..infer.encoding import ENCODING, encode, swap_labels
-from ..infer.rays import RAY_ENCODING, field_rays, ray_features
+from ..infer.rays import RAY_ENCODING, CrossField, field_rays, ray_features
 from .augment import jitter_nodes, smooth_deformation
 from .families import family
 
@@ -86,7 +86,7 @@ def make_sample(source, seed: int, index: int, nodes: int = 2048):
     except PartitionError:
         return None, "partition not four-sided"
     hints = ray_features(mesh.nodes, mesh.triangles, ref.field.theta, field_rays(ref.field),
-                         mesh.element_size)
+                         mesh.element_size, CrossField.on(mesh, ref.field.theta))
     nodes_xy, theta, carried = smooth_deformation(
         mesh.nodes, ref.field.theta,
         np.column_stack([ref.labels, hints[:, 0:2], hints[:, 4:6]]), rng)
