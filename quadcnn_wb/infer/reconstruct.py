@@ -7,10 +7,12 @@ current direction, until a singular point or the boundary is reached.  The node 
 then Laplace-smoothed, fitted by a smoothing spline and its ends snapped exactly onto the
 singular point or the boundary curve.
 
-Two departures from the letter of §4, both needed where streamlines lie a few elements
-apart (four holes): after each hop the walk moves across its heading onto the middle of
-the labelled band (hopping between nodes drifts to one side, over to the next band), and
-it ends at a singular point only when it closes in on it along one of its separatrices
+Departures from the letter of §4, needed where streamlines lie a few elements apart
+(four holes): a candidate lying off the line ahead pays for it (LATERAL) and after each
+hop the walk moves across its heading onto the middle of the labelled band (hopping
+between nodes drifts to one side, over to the next band); the first 0.75 element runs
+straight along the separatrix (the crosses turn fast right at a singular point); and a
+walk ends at a singular point only when it closes in on it along one of its separatrices
 (as numerical tracing does), never because it passes beside it.
 
 Trust but verify: a walk that stalls, turns back, jumps over a gap, leaves the domain,
@@ -40,7 +42,7 @@ SMOOTHING_PASSES = 5
 MAX_STRAY = 25.0  # degrees a rebuilt line may run across the field (over an element)
 LEAVE = 0.75  # element sizes walked straight along the separatrix before the first hop
 LATERAL = 0.3  # score penalty per element size a candidate lies off the heading's line
-BAND_HALF_WIDTH = 1.0  # nodes this far across the heading (element sizes) form its band
+BAND_HALF_WIDTH = 1.0  # labelled nodes within this radius (element sizes) of a hop make its band
 
 
 @dataclass(frozen=True)
