@@ -38,7 +38,7 @@ from ..core.transform import similarity, transform_domain_json
 from ..infer.cnn import cnn_streamlines
 from ..infer.encoding import model_input, swap_labels
 from ..infer.models import model_paths
-from ..infer.predictor import Predictor
+from ..infer.predictor import INPUT_WIDTHS, Predictor
 from ..infer.rays import hint_labels
 from ..infer.reconstruct import reconstruct_streamlines
 from ..learn.families import family
@@ -88,7 +88,7 @@ def label_source(model: Path, labels: str):
             found = frame_labels(background, field.frames,
                                  trace_streamlines(domain, background, field))
         else:
-            x, swapped = model_input(background, field, 10)
+            x, swapped = model_input(background, field, max(INPUT_WIDTHS))
             found = swap_labels(hint_labels(x), swapped)
         return reconstruct_streamlines(domain, background, field, found)
 

@@ -216,25 +216,13 @@ def loop_signed_area(loop) -> float:
 
 def winding_number(loop, q) -> int:
     """How many times the closed loop winds around point q (q must not lie on it)."""
-    q = np.asarray(q, dtype=float)
-    total = 0.0
-    for c in loop:
-        a, b = c.p0 - q, c.p1 - q
-        total += math.atan2(cross2(a, b), float(np.dot(a, b)))
-        if isinstance(c, Arc) and np.hypot(*(q - c.center)) < c.radius:
-            # Closing the arc with its chord bounds a circular segment; q inside it adds a turn.
-            if c.is_full:
-                inside = True
-            else:
-                chord = c.p1 - c.p0
-                inside = cross2(chord, q - c.p0) * cross2(chord, c.midpoint() - c.p0) > 0.0
-            if inside:
-                total += TWO_PI if c.sweep > 0 else -TWO_PI
-    return int(round(total / TWO_PI))
+    return int(winding_numbers(loop, q)[0])
 
 
 def winding_numbers(loop, points: np.ndarray) -> np.ndarray:
-    """winding_number for many points at once (none may lie on the loop)."""
+    """How many times the closed loop winds around each point (none may lie on it): the
+    angle each curve's end points subtend, plus a whole turn for a point inside the
+    circular segment an arc bounds with its chord."""
     q = np.asarray(points, dtype=float).reshape(-1, 2)
     total = np.zeros(len(q))
     for c in loop:

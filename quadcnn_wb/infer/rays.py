@@ -77,15 +77,15 @@ def bent_rays(rays: Rays, nodes: np.ndarray, triangles: np.ndarray, theta: np.nd
     rays marched together.  Returns one (M, 2) polyline per ray and, per ray, the source
     it ended at (-1: the boundary).
     """
-    return _march(rays, CrossField(nodes, triangles, theta), nodes, boundary_edges(triangles),
-                  h, step)
+    edges = boundary_edges(triangles)
+    return _march(rays, CrossField(nodes, triangles, theta), nodes, edges,
+                  cKDTree(nodes[np.unique(edges)]), h, step)
 
 
-def _march(rays, field, nodes, edges, h, step=1.0):
+def _march(rays, field, nodes, edges, boundary_tree, h, step=1.0):
     r = len(rays.starts)
     if not r:
         return [], np.zeros(0, dtype=np.int64)
-    boundary_tree = cKDTree(nodes[np.unique(edges)])
     a, e = nodes[edges[:, 0]], nodes[edges[:, 1]] - nodes[edges[:, 0]]
     reach = step * h + float(np.hypot(*e.T).max())  # farther from the boundary: no crossing
     diag = float(np.hypot(*np.ptp(nodes, axis=0)))
@@ -225,7 +225,8 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
     out[:, 4:] = 0.0
     field = field or CrossField(nodes, triangles, theta)
     edges = boundary_edges(triangles)
-    tracks, ended_at = _march(rays, field, nodes, edges, h)
+    boundary_tree = cKDTree(nodes[np.unique(edges)])
+    tracks, ended_at = _march(rays, field, nodes, edges, boundary_tree, h)
     lines = [tracks[i] for i in one_ray_per_separatrix(rays, tracks, ended_at)
              if len(tracks[i]) > 1]
     if lines:
@@ -243,8 +244,7 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
             out[:, column] = np.minimum(best / h, CLIP) / CLIP
         frames = np.column_stack([np.cos(theta), np.sin(theta), -np.sin(theta), np.cos(theta)])
         out[:, 4:] = crossed_labels(field.walker, field.centroids, h, frames, lines)
-    boundary = np.unique(edges)
-    out[:, 2] = np.minimum(cKDTree(nodes[boundary]).query(nodes)[0] / h, CLIP) / CLIP
+    out[:, 2] = np.minimum(boundary_tree.query(nodes)[0] / h, CLIP) / CLIP
     if len(rays.sources):
         out[:, 3] = np.minimum(cKDTree(rays.sources).query(nodes)[0] / h, CLIP) / CLIP
     return out.astype(np.float32)

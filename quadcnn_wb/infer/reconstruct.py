@@ -146,11 +146,9 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, sources, boundary
         heading[active] = new_heading
         for i in active:
             paths[i].append(current[i].copy())
-        going = np.ones(len(active), dtype=bool)
-        for j, i in enumerate(active):
-            if travelled[i] > limit:
-                walks[i] = Walk(None, "ran longer than any streamline should")
-                going[j] = False
+        going = travelled[active] <= limit
+        for i in active[~going]:
+            walks[i] = Walk(None, "ran longer than any streamline should")
         hits = snap.reached(current[active], previous, travelled[active], active, h)
         for j, i in enumerate(active):
             if going[j] and hits[j] is not None:

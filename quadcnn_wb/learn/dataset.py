@@ -31,7 +31,7 @@ from ..core.partition import PartitionError, build_partition
 from ..core.reference import numerical_reference
 from ..core.transform import similarity, transform_domain_json
 from ..infer.encoding import ENCODING, encode, swap_labels
-from ..infer.rays import RAY_ENCODING, CrossField, field_rays, ray_features
+from ..infer.rays import PAIRS, RAY_ENCODING, CrossField, field_rays, ray_features
 from .augment import jitter_nodes, smooth_deformation
 from .families import family
 
@@ -87,10 +87,10 @@ def make_sample(source, seed: int, index: int, nodes: int = 2048):
         return None, "partition not four-sided"
     hints = ray_features(mesh.nodes, mesh.triangles, ref.field.theta, field_rays(ref.field),
                          mesh.element_size, CrossField.on(mesh, ref.field.theta))
+    paired = [c for pair in PAIRS for c in pair]  # hints that bend along with v1 and v2
     nodes_xy, theta, carried = smooth_deformation(
-        mesh.nodes, ref.field.theta,
-        np.column_stack([ref.labels, hints[:, 0:2], hints[:, 4:6]]), rng)
-    hints = np.column_stack([carried[:, 2:4], hints[:, 2:4], carried[:, 4:6]])
+        mesh.nodes, ref.field.theta, np.column_stack([ref.labels, hints[:, paired]]), rng)
+    hints[:, paired] = carried[:, 2:]
     x, swapped = encode(nodes_xy, theta, hints)
     labels = swap_labels(carried[:, :2], swapped)
     return Sample(x=x, y=np.rint(labels).astype(np.uint8)), None
