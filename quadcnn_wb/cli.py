@@ -154,11 +154,12 @@ def _run_background(args) -> None:
     domain = load_domain(args.input)
     mesh = background_mesh(domain, nodes=args.nodes)
     if out:
-        write_json_atomic(out, mesh.to_json())
+        write_json_atomic(out, {**mesh.to_json(), "healed": list(domain.healed)})
     if png:
         from .viz.background_plot import plot_background
 
         plot_background(domain, mesh, png)
+    _report_healing(domain)
     print(f"{mesh.n_nodes} nodes, {len(mesh.triangles)} triangles, "
           f"{len(mesh.boundary_nodes)} on the boundary, {len(mesh.corner_nodes)} corners")
 
@@ -176,6 +177,7 @@ def _run_field(args) -> None:
 
         plot_field(ref.domain, ref.mesh, ref.field, ref.streamlines, png, labels=ref.labels)
     counts = ref.field.valences()
+    _report_healing(ref.domain)
     capped = sum(line.capped for line in ref.streamlines)
     print(f"{ref.mesh.n_nodes} nodes, {counts[3]} valence-3 and {counts[5]} valence-5 singular "
           f"points, {len(ref.field.corner_sources)} concave corners, {len(ref.streamlines)} "
@@ -214,12 +216,20 @@ def _run_mesh(args) -> None:
         plot_mesh(result, png)
     if not result.structured:
         print(f"warning: {result.problem}", file=sys.stderr)
+    _report_healing(domain)
     q = result.quality
-    print(f"{q['quads']} quads in {q['blocks']} blocks, min scaled Jacobian "
+    print(f"{q['quads']} quads in {q['blocks']} blocks "
+          f"({100 * result.structured_share:.0f} % of the quads in blocks), min scaled Jacobian "
           f"{q['min_scaled_jacobian']:.3f} (mean {q['mean_scaled_jacobian']:.3f}), "
           f"{q['irregular_vertices']} irregular vertices, "
           f"{len(result.reference.field.singularities)} singular points, "
           f"{result.timings['total']:.3f} s ({result.method})")
+
+
+def _report_healing(domain) -> None:
+    """One line per thing the input healing changed, so a user sees the part was touched."""
+    for note in domain.healed:
+        print(f"healed: {note}")
 
 
 def _run_families(args) -> None:

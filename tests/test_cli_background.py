@@ -17,7 +17,8 @@ def test_background_json_and_png(tmp_path):
                      "-o", out, "--png", png)
     assert result.returncode == 0, result.stderr
     data = json.loads(out.read_text())
-    assert set(data) == {"nodes", "triangles", "boundary_nodes", "corners"}
+    assert set(data) == {"nodes", "triangles", "boundary_nodes", "corners", "healed"}
+    assert data["healed"] == []
     nodes, tris = np.array(data["nodes"]), np.array(data["triangles"])
     assert nodes.shape[1] == 2 and abs(len(nodes) - 1500) <= 75
     assert tris.min() == 0 and tris.max() == len(nodes) - 1

@@ -17,9 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from .curves import Arc, Line, curve_bbox, loop_signed_area, winding_number
+from .healing import HEAL_TOL, drop_crumbs, merge_curves, report_gaps
 from .intersections import Overlap, curve_intersections
 
-CLOSE_TOL = 1e-9  # relative to the domain size, as DESIGN.md states for loop closure
+CLOSE_TOL = 1e-9  # relative to the domain size: what counts as exact
 CAD_SUFFIXES = {".step", ".stp", ".brep", ".brp", ".iges", ".igs"}
 
 
@@ -33,6 +34,7 @@ class Domain:
     units: str = "mm"
     bbox_min: np.ndarray = field(default=None, compare=False)
     bbox_max: np.ndarray = field(default=None, compare=False)
+    healed: tuple = field(default=(), compare=False)  # what the input healing changed
 
     @property
     def size(self) -> float:
@@ -156,17 +158,24 @@ def make_domain(loops, units: str = "mm") -> Domain:
 
     Arcs may be given as curves or as (start, middle, end) point triples; the latter are
     checked for collinearity here, where the domain size that sets the tolerance is known.
+    What CAD kernels leave within HEAL_TOL of the part's size is healed first (see
+    healing.py) and listed in ``Domain.healed``.
     """
     size = _raw_size(loops)
     eps = CLOSE_TOL * size
+    heal = HEAL_TOL * size
+    notes = []
+    loops = drop_crumbs(loops, heal, notes)
     curves = [[_make_arc(c, li, si, eps) if isinstance(c, tuple) else c
                for si, c in enumerate(loop)] for li, loop in enumerate(loops)]
     for li, loop in enumerate(curves):
-        _check_loop_shape(loop, li, eps)
-    curves = [_close_loop(loop) for loop in curves]
+        _check_loop_shape(loop, li, eps, heal)
+    report_gaps(curves, eps, notes)
+    curves = [merge_curves(_close_loop(loop), li, heal, notes)
+              for li, loop in enumerate(curves)]
     for li, loop in enumerate(curves):
         _check_not_flat(loop, li, eps)
-    _check_intersections(curves, eps)
+    _check_intersections(curves, eps, heal)
     oriented = []
     for li, loop in enumerate(curves):
         ccw = loop_signed_area(loop) > 0
@@ -175,7 +184,7 @@ def make_domain(loops, units: str = "mm") -> Domain:
     _check_nesting(oriented)
     boxes = [curve_bbox(c) for loop in oriented for c in loop]
     domain = Domain(tuple(oriented), units, np.min([b[0] for b in boxes], axis=0),
-                    np.max([b[1] for b in boxes], axis=0))
+                    np.max([b[1] for b in boxes], axis=0), tuple(notes))
     if domain.area <= 1e-12 * domain.size**2:
         raise DomainError("the domain has zero area")
     return domain
@@ -211,23 +220,22 @@ def _make_arc(points, li: int, si: int, eps: float) -> Arc:
     return Arc.through(p0, pm, p1)
 
 
-def _check_loop_shape(loop, li: int, eps: float) -> None:
+def _check_loop_shape(loop, li: int, eps: float, heal: float) -> None:
     full = [si for si, c in enumerate(loop) if isinstance(c, Arc) and c.is_full]
     if full and len(loop) > 1:
         raise DomainError(f"{_where(li, full[0])}: a circle must be a loop by itself")
     for si, c in enumerate(loop):
-        if isinstance(c, Line) and c.length <= eps:
-            raise DomainError(f"{_where(li, si)}: zero-length segment")
-    for si, c in enumerate(loop):
         nxt = loop[(si + 1) % len(loop)]
         gap = float(np.hypot(*(nxt.p0 - c.p1)))
-        if gap > eps:
+        if gap > heal:
             if len(loop) == 1:
                 raise DomainError(f"{_where(li)}: open loop, its only segment does not end "
-                                  f"where it starts (gap {gap:.6g})")
+                                  f"where it starts (gap {gap:.6g}, more than the healing "
+                                  f"tolerance {heal:.3g})")
             raise DomainError(f"{_where(li)}: open loop, segment {si} ends at "
                               f"{_fmt(c.p1)} but segment {(si + 1) % len(loop)} starts at "
-                              f"{_fmt(nxt.p0)} (gap {gap:.6g})")
+                              f"{_fmt(nxt.p0)} (gap {gap:.6g}, more than the healing "
+                              f"tolerance {heal:.3g})")
 
 
 def _fmt(p) -> str:
@@ -256,7 +264,10 @@ def _check_not_flat(loop, li: int, eps: float) -> None:
         raise DomainError(f"{_where(li)}: zero area (all its points lie on one line)")
 
 
-def _check_intersections(loops, eps: float) -> None:
+def _check_intersections(loops, eps: float, heal: float) -> None:
+    """Curves meet only where consecutive ones join.  At a tangent joint (a fillet) a
+    kernel's round-off lets the curves cross again within about sqrt(2 r tol) of it,
+    so such a second meeting is allowed that close to the joint and no farther."""
     flat = [(li, si, c) for li, loop in enumerate(loops) for si, c in enumerate(loop)]
     boxes = np.array([np.concatenate(curve_bbox(c)) for _, _, c in flat])
     lo, hi = boxes[:, :2] - eps, boxes[:, 2:] + eps
@@ -270,8 +281,10 @@ def _check_intersections(loops, eps: float) -> None:
             points = curve_intersections(ci, cj, eps)
         except Overlap:
             raise DomainError(_pair_message(li, si, lj, sj, "overlap")) from None
+        radius = max([c.radius for c in (ci, cj) if isinstance(c, Arc)], default=0.0)
+        near = 10 * eps + math.sqrt(2.0 * heal * radius)
         for p in points:
-            if all(np.hypot(*(p - v)) > 10 * eps for v in allowed):
+            if all(np.hypot(*(p - v)) > near for v in allowed):
                 raise DomainError(_pair_message(li, si, lj, sj, f"cross at {_fmt(p)}"))
 
 

@@ -43,7 +43,8 @@ def write_inp(path, domain, mesh, element_type: str = "CPS4") -> None:
             for i, q in enumerate(mesh.quads + 1, start=1):
                 f.write(f"{i}, {q[0]}, {q[1]}, {q[2]}, {q[3]}\n")
             for b in np.unique(mesh.block_of_quad):
-                _write_set(f, "ELSET", f"BLOCK{b}", np.nonzero(mesh.block_of_quad == b)[0] + 1)
+                name = f"BLOCK{b}" if b >= 0 else "UNSTRUCTURED"  # quads in no block
+                _write_set(f, "ELSET", name, np.nonzero(mesh.block_of_quad == b)[0] + 1)
             for name, ids in boundary_node_sets(domain, mesh.nodes, mesh.boundary).items():
                 _write_set(f, "NSET", name, np.asarray(ids) + 1)
 

@@ -98,7 +98,11 @@ def _same_circle(c1: Arc, c2: Arc, eps: float) -> list[np.ndarray]:
         raise Overlap
 
     def strictly_inside(arc: Arc, p) -> bool:
-        return _on_arc(arc, p, -eps)
+        """On the arc and more than eps from both of its ends."""
+        ang = math.atan2(p[1] - arc.center[1], p[0] - arc.center[0])
+        rel = (ang - arc.a0) * (1.0 if arc.sweep > 0 else -1.0) % (2.0 * math.pi)
+        margin = eps / arc.radius
+        return margin < rel < abs(arc.sweep) - margin
 
     probes = [(c1, c2.p0), (c1, c2.p1), (c1, c2.midpoint()), (c2, c1.p0), (c2, c1.p1),
               (c2, c1.midpoint())]

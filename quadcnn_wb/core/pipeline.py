@@ -19,7 +19,7 @@ from .gmsh_quads import gmsh_quad_mesh
 from .partition import Partition, PartitionError, build_partition
 from .pose import diameter
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
-from .quality import mesh_quality
+from .quality import mesh_quality, structured_share
 from .quantize import quantize
 from .reference import Reference, background_and_field
 from .tracing import trace_streamlines
@@ -40,9 +40,14 @@ class MeshResult:
     size: float
     method: str = "numerical"
     fallback: list = field(default_factory=list)
-    structured: bool = True  # False: the partition failed and gmsh's quad mesh stands in
+    structured: bool = True  # False: no block partition; gmsh's quad mesh stands in
     problem: str = ""  # why the mesh is not block-structured
     timings: dict = field(default_factory=dict)
+
+    @property
+    def structured_share(self) -> float:
+        """Share of the quads that lie in blocks: 1.0 for a fully block-structured mesh."""
+        return structured_share(self.mesh)
 
     @property
     def streamlines(self) -> list:
@@ -60,6 +65,8 @@ class MeshResult:
             "method": self.method,
             "fallback": list(self.fallback),
             "structured": self.structured,
+            "structured_share": self.structured_share,
+            "healed": list(self.domain.healed),
             **({"problem": self.problem} if self.problem else {}),
             "quality": dict(self.quality),
             "timings": dict(self.timings),
@@ -119,8 +126,9 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
             cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
     except PartitionError as exc:
-        # Never leave a valid input without a mesh: gmsh's unstructured quads stand in.
-        problem = f"no block structure ({exc}); unstructured all-quad mesh from gmsh"
+        # Never leave a valid input without a mesh, nor with one worse than gmsh's own:
+        # gmsh's quasi-structured quads stand in.
+        problem = f"no block structure ({exc}); gmsh's quasi-structured quads stand in"
         cuts, partition, counts = [], Partition(np.zeros((0, 2)), [], [], []), np.zeros(0, int)
         clock = time.perf_counter()
         mesh = gmsh_quad_mesh(domain, size)

@@ -34,6 +34,16 @@ def irregular_vertices(quads, n_nodes: int, expected) -> np.ndarray:
     return np.nonzero(used & (count != expected))[0]
 
 
+def min_scaled_jacobian(mesh) -> float:
+    sj = scaled_jacobians(mesh.nodes, mesh.quads)
+    return float(sj.min()) if len(sj) else 0.0
+
+
+def structured_share(mesh) -> float:
+    """Share of the quads that lie in blocks (block -1: a quad in no block)."""
+    return float(np.mean(mesh.block_of_quad >= 0)) if len(mesh.quads) else 0.0
+
+
 def mesh_quality(domain, mesh) -> dict:
     sj = scaled_jacobians(mesh.nodes, mesh.quads)
     expected = boundary_quads_expected(domain, mesh.nodes, mesh.boundary)
@@ -42,6 +52,6 @@ def mesh_quality(domain, mesh) -> dict:
         "min_scaled_jacobian": float(sj.min()) if len(sj) else 0.0,
         "mean_scaled_jacobian": float(sj.mean()) if len(sj) else 0.0,
         "irregular_vertices": int(len(irregular)),
-        "blocks": int(len(np.unique(mesh.block_of_quad))),
+        "blocks": int(len(np.unique(mesh.block_of_quad[mesh.block_of_quad >= 0]))),
         "quads": int(len(mesh.quads)),
     }

@@ -38,6 +38,7 @@ class Reference:
         out["streamline_ends"] = [{"start": line.start.to_json(), "end": line.end.to_json(),
                                    "capped": line.capped} for line in self.streamlines]
         out["labels"] = self.labels.tolist()
+        out["healed"] = list(self.domain.healed)
         return out
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .background import BackgroundMesh
+from .curves import Arc
 from .domain import Domain
 from .framefield import FrameField
 
@@ -95,12 +96,19 @@ class _BoundaryIndex:
         if self.next[b] == a:
             a, b, s = b, a, 1.0 - s
         li, si, ta = int(self.loop[a]), int(self.segment[a]), float(self.param[a])
-        tb = float(self.param[b]) if self.segment[b] == si and self.param[b] > ta else 1.0
+        if self.segment[b] != si:
+            return li, si, ta + s * (1.0 - ta)  # b starts the next curve: t = 1 on this one
+        tb = float(self.param[b])
+        if tb <= ta:  # the edge across a circle's seam (t = 0 lies inside it)
+            t = ta + s * (tb + 1.0 - ta)
+            return li, si, t - 1.0 if t >= 1.0 else t
         return li, si, ta + s * (tb - ta)
 
     def endpoint(self, li: int, si: int, t: float, element: float) -> tuple[Endpoint, np.ndarray]:
         loop = self.domain.loops[li]
         curve = loop[si]
+        if isinstance(curve, Arc) and curve.is_full:  # a circle's t = 0 is no vertex
+            return Endpoint("boundary", -1, li, si, float(t)), curve.point(t)
         along = t * curve.length
         if along <= CORNER_SNAP * element:
             t = 0.0

@@ -20,7 +20,7 @@ def fem_mesh(result, placement):
     for j, quad in enumerate(mesh.quads, start=1):
         fm.addFace([int(n) + 1 for n in quad], j)
     for b in sorted(set(int(b) for b in mesh.block_of_quad)):
-        group = fm.addGroup(f"Block{b}", "Face")
+        group = fm.addGroup(f"Block{b}" if b >= 0 else "Unstructured", "Face")
         fm.addGroupElements(group, [j + 1 for j, owner in enumerate(mesh.block_of_quad)
                                     if owner == b])
     for name, ids in boundary_node_sets(result.domain, mesh.nodes, mesh.boundary).items():

@@ -42,6 +42,10 @@ PROPERTIES = (
      "Streamlines the cnn path had to trace numerically"),
     ("App::PropertyString", "Timings", "Results", "Seconds per stage (JSON)"),
     ("App::PropertyString", "Status", "Results", "ok, or what went wrong last time"),
+    ("App::PropertyFloat", "StructuredShare", "Results",
+     "Share of the quads that lie in blocks (1: fully block-structured)"),
+    ("App::PropertyStringList", "Healed", "Results",
+     "What the input healing changed (joined gaps, merged arcs and lines)"),
     ("App::PropertyVectorList", "SingularPoints", "Results",
      "Singular points of the frame field (global coordinates)"),
     ("App::PropertyIntegerList", "SingularValences", "Results",
@@ -49,7 +53,7 @@ PROPERTIES = (
 )
 READ_ONLY = ("Blocks", "Quads", "Singularities", "MinScaledJacobian", "IrregularVertices",
              "MethodUsed", "Fallbacks", "Timings", "Status", "SingularPoints",
-             "SingularValences", "ModelEntry")
+             "SingularValences", "ModelEntry", "StructuredShare", "Healed")
 DEFAULTS = {"Method": ["auto", "cnn", "numerical"], "TargetNodes": 2048, "Smoothing": True}
 
 
@@ -130,7 +134,10 @@ class QuadMeshProxy(Stateless):
         obj.MethodUsed = result.method
         obj.Fallbacks = list(result.fallback)
         obj.Timings = json.dumps({k: round(v, 4) for k, v in result.timings.items()})
-        obj.Status = "ok" if result.structured else f"ok, but {result.problem}"
+        obj.StructuredShare = result.structured_share
+        obj.Healed = list(domain.healed)
+        healed = f" (input healed: {'; '.join(domain.healed)})" if domain.healed else ""
+        obj.Status = ("ok" if result.structured else f"ok, but {result.problem}") + healed
         if not result.structured:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {result.problem}\n")
         FreeCAD.Console.PrintLog(f"{obj.Label}: {q['quads']} quads in "

@@ -19,6 +19,7 @@ def plot_mesh(result, path, title=None) -> None:
     rng = np.random.default_rng(7)
     palette = rng.uniform(0.55, 0.95, size=(max(q["blocks"], 1), 3))
     colours = palette[mesh.block_of_quad % len(palette)]
+    colours[mesh.block_of_quad < 0] = 0.8  # quads in no block: grey
     ax.add_collection(PolyCollection(mesh.nodes[mesh.quads], facecolors=colours,
                                      edgecolors="#33415c", linewidths=0.3, zorder=1))
     draw_boundary(ax, result.domain)

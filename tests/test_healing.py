@@ -1,0 +1,136 @@
+"""What CAD kernels deliver is healed and reported; real gaps and crossings stay errors."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from conftest import rect, run_cli
+
+from quadcnn_wb.core.domain import DomainError, domain_from_json
+from quadcnn_wb.core.healing import HEAL_TOL
+from quadcnn_wb.core.pipeline import mesh_domain
+
+L = lambda a, b: {"line": [a, b]}  # noqa: E731
+
+
+def arcs(center, radius, angles):
+    """A loop of arcs of one circle through the given angles (radians)."""
+    def at(t):
+        return [center[0] + radius * math.cos(t), center[1] + radius * math.sin(t)]
+
+    return [{"arc": [at(a), at(0.5 * (a + b)), at(b)]} for a, b in zip(angles[:-1], angles[1:])]
+
+
+SPLITS = {"2x180": [0, 180, 360], "3x120": [0, 120, 240, 360], "4x90": [0, 90, 180, 270, 360],
+          "90+270": [0, 90, 360]}
+
+
+@pytest.mark.parametrize("split", SPLITS)
+@pytest.mark.parametrize("offset", [0.0, 17.0, 133.0])
+def test_a_hole_stored_as_arcs_is_one_circle(split, offset):
+    angles = [math.radians(a + offset) for a in SPLITS[split]]
+    domain = domain_from_json({"loops": [rect(100, 60), arcs([50, 30], 10, angles)]})
+    (hole,) = domain.loops[1]
+    assert hole.kind == "circle" and hole.radius == pytest.approx(10)
+    assert domain.area == pytest.approx(6000 - math.pi * 100)
+    assert any("arcs of one circle merged" in note for note in domain.healed)
+
+
+def test_a_hole_of_arcs_meshes_like_the_circle():
+    whole = domain_from_json({"loops": [rect(100, 60), [{"circle": {"center": [50, 30],
+                                                                     "radius": 10}}]]})
+    split = domain_from_json({"loops": [rect(100, 60),
+                                        arcs([50, 30], 10, [math.radians(a) for a in
+                                                            (0, 90, 180, 270, 360)])]})
+    a, b = mesh_domain(whole), mesh_domain(split)
+    assert a.structured and b.structured
+    assert a.quality["quads"] == b.quality["quads"]
+    assert a.quality["irregular_vertices"] == b.quality["irregular_vertices"]
+
+
+def test_a_fillet_run_of_two_arcs_is_one_arc():
+    # A quarter round corner stored as two 45° arcs.
+    c, r = [80, 40], 20
+    quarter = arcs(c, r, [0, math.pi / 4, math.pi / 2])
+    loop = [L([0, 0], [100, 0]), L([100, 0], [100, 40]), *quarter, L([80, 60], [0, 60]),
+            L([0, 60], [0, 0])]
+    domain = domain_from_json({"loops": [loop]})
+    assert [c.kind for c in domain.loops[0]] == ["line", "line", "arc", "line", "line"]
+    assert domain.healed
+
+
+def test_collinear_lines_merge_and_the_part_is_unchanged():
+    loop = [L([0, 0], [40, 0]), L([40, 0], [100, 0]), L([100, 0], [100, 60]),
+            L([100, 60], [0, 60]), L([0, 60], [0, 0])]
+    domain = domain_from_json({"loops": [loop]})
+    assert len(domain.loops[0]) == 4 and domain.area == pytest.approx(6000)
+    assert any("collinear lines merged" in note for note in domain.healed)
+
+
+def test_clean_input_reports_no_healing():
+    assert domain_from_json({"loops": [rect(100, 60)]}).healed == ()
+
+
+def test_micrometre_gaps_of_a_300_mm_part_are_joined():
+    gap = 5e-3  # 5 µm in mm
+    loop = [L([0, 0], [300, 0]), L([300, gap], [300, 200]), L([300 + gap, 200], [0, 200]),
+            L([0, 200 - gap], [0, 0])]
+    domain = domain_from_json({"loops": [loop, arcs([150, 100], 30, [0, math.pi, 2 * math.pi])]})
+    notes = " ".join(domain.healed)
+    assert "joined 3 gap(s)" in notes and "arcs of one circle" in notes
+    assert domain.area == pytest.approx(300 * 200 - math.pi * 900, rel=1e-6)
+
+
+def test_a_real_gap_stays_an_error():
+    size = math.hypot(300, 200)
+    gap = 20 * HEAL_TOL * size
+    loop = [L([0, 0], [300, 0]), L([300, gap], [300, 200]), L([300, 200], [0, 200]),
+            L([0, 200], [0, 0])]
+    with pytest.raises(DomainError, match=r"loop 0: open loop, segment 0 ends at .*\(gap"):
+        domain_from_json({"loops": [loop]})
+
+
+def test_a_hole_of_arcs_that_do_not_close_is_an_open_loop():
+    hole = arcs([50, 30], 10, [0, math.pi, 1.9 * math.pi])
+    with pytest.raises(DomainError, match=r"loop 1: open loop"):
+        domain_from_json({"loops": [rect(100, 60), hole]})
+
+
+def test_arcs_of_one_circle_that_double_back_still_overlap():
+    hole = arcs([50, 30], 10, [0, math.pi, 2 * math.pi]) + arcs([50, 30], 10, [0, math.pi])[::-1]
+    with pytest.raises(DomainError, match=r"loop 1"):
+        domain_from_json({"loops": [rect(100, 60), hole]})
+
+
+def test_a_crumb_edge_is_dropped():
+    loop = [L([0, 0], [100, 0]), L([100, 0], [100, 1e-6]), L([100, 1e-6], [100, 60]),
+            L([100, 60], [0, 60]), L([0, 60], [0, 0])]
+    domain = domain_from_json({"loops": [loop]})
+    assert len(domain.loops[0]) == 4
+    assert any("dropped 1 segment" in note for note in domain.healed)
+
+
+def test_arcs_of_one_circle_apart_in_a_loop_are_no_overlap():
+    # A round boss with a flat cut (a D shape): both arcs lie on one circle but are not
+    # consecutive, and they only touch the flat's ends.
+    r = 10
+    a = math.radians(30)
+    p, q = [r * math.cos(a), r * math.sin(a)], [r * math.cos(a), -r * math.sin(a)]
+    up = arcs([0, 0], r, [a, math.pi])[0]
+    down = arcs([0, 0], r, [math.pi, 2 * math.pi - a])[0]
+    domain = domain_from_json({"loops": [[L(q, p), up, down]]})
+    assert [c.kind for c in domain.loops[0]] == ["line", "arc"]  # the two arcs merge
+
+
+def test_healing_is_reported_on_the_command_line(write_json, tmp_path):
+    path = write_json({"loops": [rect(100, 60), arcs([50, 30], 10, [0, math.pi,
+                                                                       2 * math.pi])]})
+    out = tmp_path / "mesh.json"
+    run = run_cli("mesh", path, "-o", out)
+    assert run.returncode == 0, run.stderr
+    assert "healed: loop 1: 1 joint(s) between arcs of one circle merged" in run.stdout
+    data = json.loads(out.read_text())
+    assert data["healed"] == ["loop 1: 1 joint(s) between arcs of one circle merged"]
+    assert data["structured_share"] == 1.0
