@@ -11,38 +11,12 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
-import gmsh
-import numpy as np
-
-from ..core.background import _build_geometry
-from ..core.gmsh_quads import read_quads
-from ..core.gmsh_session import gmsh_session
+from ..core.gmsh_quads import gmsh_quasi_structured
 from ..core.pipeline import DEFAULT_SIZE_DIVISOR, mesh_domain
-from ..core.pose import Pose
 from ..core.quadmesh import scaled_jacobians
 from ..core.quality import boundary_quads_expected, irregular_vertices
 from .common import bundled_examples
-
-
-def gmsh_quasi_structured(domain, size: float):
-    """(nodes, quads, boundary mask, seconds) from gmsh's algorithm 11."""
-    with gmsh_session() as session:
-        _build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
-        for name, value in (("Mesh.Algorithm", 11), ("Mesh.MeshSizeMin", size),
-                            ("Mesh.MeshSizeMax", size), ("Mesh.MeshSizeFromPoints", 0),
-                            ("Mesh.MeshSizeFromCurvature", 0)):
-            session.set(name, value)
-        start = time.perf_counter()
-        gmsh.model.mesh.generate(2)
-        seconds = time.perf_counter() - start
-        nodes, quads, index = read_quads()
-        boundary = np.zeros(len(nodes), dtype=bool)
-        for _, tag in gmsh.model.getEntities(1):
-            btags, _, _ = gmsh.model.mesh.getNodes(1, tag, includeBoundary=True)
-            boundary[[index[int(t)] for t in btags]] = True
-    return nodes, quads, boundary, seconds
 
 
 def score(domain, nodes, quads, boundary):

@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 from .curves import Arc, cross2
 from .domain import Domain
 from .gmsh_session import gmsh_session
-from .pose import Pose, canonical_pose
+from .pose import KEY_DIGITS, Pose, canonical_pose
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
@@ -151,8 +151,9 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     if nodes < 8:
         raise ValueError(f"--nodes must be at least 8, got {nodes}")
     pose = canonical_pose(domain)
-    unit_area = unit(domain.area / pose.scale**2)
-    unit_perimeter = unit(domain.perimeter / pose.scale)
+    # Rounded well above round-off (a moved or turned copy must ask gmsh for the same size).
+    unit_area = round(domain.area / pose.scale**2, KEY_DIGITS)
+    unit_perimeter = round(domain.perimeter / pose.scale, KEY_DIGITS)
     h = size_for_nodes(unit_area, unit_perimeter, domain.holes, nodes / GMSH_DENSITY)
     tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
@@ -186,7 +187,8 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale)
 
 
-UNIT_DIGITS = 12  # unit coordinates are rounded to this many decimals before gmsh
+UNIT_DIGITS = 9  # unit coordinates are rounded to this many decimals before gmsh: far
+#                 above the round-off of a part moved by 1e4 of its size (~1e-12)
 
 
 def unit(value):

@@ -68,9 +68,9 @@ class Line:
     def sample(self, n: int) -> np.ndarray:
         return self.point(np.linspace(0.0, 1.0, n))
 
-    def signed_area_term(self) -> float:
-        """This curve's share of 0.5 * closed-integral (x dy - y dx)."""
-        return 0.5 * cross2(self.p0, self.p1)
+    def signed_area_term(self, origin=(0.0, 0.0)) -> float:
+        """This curve's share of 0.5 * closed-integral (x dy - y dx), about ``origin``."""
+        return 0.5 * cross2(self.p0 - origin, self.p1 - origin)
 
     def to_json(self) -> dict:
         return {"line": [self.p0.tolist(), self.p1.tolist()]}
@@ -179,9 +179,11 @@ class Arc:
     def midpoint(self) -> np.ndarray:
         return self.point(0.5)
 
-    def signed_area_term(self) -> float:
-        """This curve's share of 0.5 * closed-integral (x dy - y dx), exactly."""
-        return 0.5 * (cross2(self.center, self.p1 - self.p0) + self.radius**2 * self.sweep)
+    def signed_area_term(self, origin=(0.0, 0.0)) -> float:
+        """This curve's share of 0.5 * closed-integral (x dy - y dx) about ``origin``,
+        exactly."""
+        return 0.5 * (cross2(self.center - origin, self.p1 - self.p0)
+                      + self.radius**2 * self.sweep)
 
     def to_json(self) -> dict:
         if self.is_full:
@@ -211,7 +213,10 @@ def curve_bbox(curve) -> tuple[np.ndarray, np.ndarray]:
 
 
 def loop_signed_area(loop) -> float:
-    return float(sum(c.signed_area_term() for c in loop))
+    """Taken about the loop's first point: far from the origin (a part placed at 1e4 of
+    its size) the products of absolute coordinates would cancel away the area's digits."""
+    origin = np.asarray(loop[0].p0, dtype=float)
+    return float(sum(c.signed_area_term(origin) for c in loop))
 
 
 def winding_number(loop, q) -> int:

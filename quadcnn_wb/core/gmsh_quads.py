@@ -3,7 +3,9 @@ peer every benchmark measures against.
 
 The product promise is a valid mesh for every valid input, and never one worse than
 gmsh's own on the same face, so the stand-in is gmsh's quasi-structured algorithm (11) at
-the same element size: the very mesh a user would get from gmsh directly.  Should it
+the same element size: the very mesh a user would get from gmsh directly.  (Algorithm 11
+splits each triangle of its size field into quads of half its edge, so elements of edge
+H take a gmsh size of 2 H: QUASI_STRUCTURED_SIZE_FACTOR.)  Should it
 fail (it needs a cross field of its own), frontal quads with blossom recombination and
 one subdivision stand in for it.  The result is valid but not block-structured, and the
 pipeline says so.
@@ -23,6 +25,7 @@ from .quadmesh import QuadMesh, _counter_clockwise
 from .quality import min_scaled_jacobian
 
 QUASI_STRUCTURED = 11  # gmsh's Mesh.Algorithm for quasi-structured quads
+QUASI_STRUCTURED_SIZE_FACTOR = 2.0  # gmsh size giving algorithm 11 elements of edge 1
 
 
 def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
@@ -30,7 +33,8 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
     turned or moved copy gets the same mesh); boundary nodes sit on the exact curves."""
     pose = canonical_pose(domain)
     try:
-        mesh = _gmsh_mesh(domain, pose, _quasi_structured_options(size / pose.scale))
+        mesh = _gmsh_mesh(domain, pose, _quasi_structured_options(
+            QUASI_STRUCTURED_SIZE_FACTOR * size / pose.scale))
     except Exception:  # gmsh reports every failure as a bare Exception
         mesh = None
     if mesh is None or not len(mesh.quads) or min_scaled_jacobian(mesh) <= 0.0:
@@ -40,7 +44,8 @@ def gmsh_quad_mesh(domain, size: float) -> QuadMesh:
 
 def gmsh_quasi_structured(domain, size: float):
     """(nodes, quads, boundary mask, seconds) of gmsh's algorithm 11 on the domain as
-    given: the peer of the benchmarks, timed on gmsh's meshing call alone."""
+    given, at gmsh mesh size ``size`` (elements of about size / 2): the peer of the
+    benchmarks, timed on gmsh's meshing call alone."""
     with gmsh_session() as session:
         _build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
         for name, value in _quasi_structured_options(size):

@@ -79,7 +79,10 @@ def _key(value: float, scale: float) -> float:
 
 def area_centroid(domain) -> np.ndarray:
     """Centroid of the region (holes subtracted): curves as fine polygons sampled at fixed
-    parameters, full circles exactly.  Unlike the boundary's mean it sees where holes are."""
+    parameters, full circles exactly.  Unlike the boundary's mean it sees where holes are.
+    Summed about a point of the part, not the origin: for a part far away the products
+    of absolute coordinates would cancel away most digits."""
+    origin = np.asarray(domain.loops[0][0].p0, dtype=float)
     t = np.linspace(0.0, 1.0, SAMPLES_PER_CURVE + 1)[:-1]
     area, moment = 0.0, np.zeros(2)
     for loop in domain.loops:
@@ -87,15 +90,15 @@ def area_centroid(domain) -> np.ndarray:
             c = loop[0]
             signed = math.pi * c.radius ** 2 * (1.0 if c.sweep > 0 else -1.0)
             area += signed
-            moment += signed * np.asarray(c.center, dtype=float)
+            moment += signed * (np.asarray(c.center, dtype=float) - origin)
             continue
-        poly = np.concatenate([curve.point(t) for curve in loop])
+        poly = np.concatenate([curve.point(t) for curve in loop]) - origin
         x, y = poly[:, 0], poly[:, 1]
         xn, yn = np.roll(x, -1), np.roll(y, -1)
         cross = x * yn - xn * y
         area += 0.5 * cross.sum()
         moment += np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / 6.0
-    return moment / area
+    return moment / area + origin
 
 
 def canonical_pose(domain) -> Pose:
