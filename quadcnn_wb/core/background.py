@@ -184,7 +184,7 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
             f"could not reach {nodes} nodes within {NODE_TOLERANCE:.0%} (best "
             f"{len(coords)}); the shape may have features far below the element size")
     coords = pose.from_unit(coords)
-    return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale)
+    return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale, pose.scale)
 
 
 UNIT_DIGITS = 9  # unit coordinates are rounded to this many decimals before gmsh: far
@@ -285,7 +285,8 @@ def _read_mesh(curve_tags: dict):
     return coords, triangles, curve_nodes
 
 
-def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMesh:
+def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
+              diameter_of_pose: float) -> BackgroundMesh:
     coords = np.array(coords, dtype=float)
     boundary, loops_of, segs_of, params, tangents = [], [], [], [], []
     corner_nodes, corner_angles, corner_in = [], [], []
@@ -293,11 +294,14 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h) -> BackgroundMe
         for si, curve in enumerate(loop):
             ids = curve_nodes[(li, si)]
             t = np.array([curve.project(coords[i]) for i in ids])
+            # gmsh saw coordinates rounded to UNIT_DIGITS: nodes that close to a vertex
+            # are the vertex itself (the pose's round trip is not exact either).
+            near = 100 * 10.0 ** -UNIT_DIGITS * diameter_of_pose / curve.length
             if isinstance(curve, Arc) and curve.is_full:
-                t[t >= 1.0 - 1e-9] = 0.0
-            else:  # the vertices themselves, exactly (the pose's round trip is not exact)
-                t[t <= 1e-9] = 0.0
-                t[t >= 1.0 - 1e-9] = 1.0
+                t[t >= 1.0 - near] = 0.0
+            else:
+                t[t <= near] = 0.0
+                t[t >= 1.0 - near] = 1.0
             order = np.argsort(t, kind="stable")
             ids, t = ids[order], t[order]
             if not (isinstance(curve, Arc) and curve.is_full):

@@ -126,8 +126,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
             splits[other].append((s, vid))
             splits[k].append((_length(pts), vid))
     # Crossings between streamlines.
-    for (i, si), (j, sj), xy in _crossings(lines, element_size, tol):
-        vid = verts.get(("x", i, round(si, 9), j, round(sj, 9)), xy)
+    for n, ((i, si), (j, sj), xy) in enumerate(_crossings(lines, element_size, tol)):
+        vid = verts.get(("x", n), xy)  # each crossing is found once
         splits[i].append((si, vid))
         splits[j].append((sj, vid))
     edges = []

@@ -115,7 +115,8 @@ def _march(rays, field, nodes, edges, boundary_tree, h, step=1.0):
                 t = (q[..., 0] * e[None, :, 1] - q[..., 1] * e[None, :, 0]) / denom
                 u = (q[..., 0] * m[:, None, 1] - q[..., 1] * m[:, None, 0]) / denom
             first = (count == 1)  # a corner's rays start on the boundary
-            cross = (np.abs(denom) > 1e-15) & (t > (1.0 if first else 0.0)) & (t <= 1) \
+            scale = np.hypot(*m.T)[:, None] * np.hypot(*e.T)[None, :]  # parallel: relative
+            cross = (np.abs(denom) > 1e-12 * scale) & (t > (1.0 if first else 0.0)) & (t <= 1) \
                 & (u >= 0) & (u <= 1)
             t_hit = np.where(cross, t, np.inf).min(axis=1)
             hit[c] = np.isfinite(t_hit)
