@@ -8,7 +8,8 @@ B-spline edges, seam vertices all stay as Part.read gave them.  The face is writ
     .venv/bin/python tests/corpus/extract_face.py FILE --list
     .venv/bin/python tests/corpus/extract_face.py FILE [--face N] -o tests/corpus/NAME.brep
 
-(also runs under ``freecadcmd``: the arguments after the script's own path are read).
+(any Python that imports FreeCAD 0.20: /usr/lib/freecad-python3/lib is put on sys.path;
+``freecadcmd`` itself cannot pass options to a script).
 ``--list`` prints every planar face: its index in ``shape.Faces``, area, wires, edges and
 edge kinds.  Without ``--face`` the chosen face is the planar face with the most edges
 that has at least one hole or curved edge, the larger one on a tie.
@@ -26,15 +27,6 @@ if "/usr/lib/freecad-python3/lib" not in sys.path:
 
 import FreeCAD  # noqa: E402,F401  (Part needs FreeCAD loaded first)
 import Part  # noqa: E402
-
-
-def _own_arguments(argv):
-    """The arguments after this script's path (freecadcmd puts its own in front)."""
-    me = os.path.basename(__file__)
-    for k, arg in enumerate(argv):
-        if os.path.basename(arg) == me:
-            return argv[k + 1:]
-    return argv[1:]
 
 
 def is_planar(face) -> bool:
@@ -68,7 +60,7 @@ def main(argv=None) -> int:
     parser.add_argument("--list", action="store_true", help="list the planar faces")
     parser.add_argument("--face", type=int, help="index in shape.Faces (see --list)")
     parser.add_argument("-o", "--output", help="the face's BREP file")
-    args = parser.parse_args(_own_arguments(sys.argv) if argv is None else argv)
+    args = parser.parse_args(argv)
     shape = Part.read(args.input)
     faces = shape.Faces
     if args.list:
