@@ -14,8 +14,8 @@ from shapes import OWN_SHAPES, named_domain
 
 from quadcnn_wb.bench.meshcheck import check_quad_mesh
 from quadcnn_wb.core.domain import load_domain
+from quadcnn_wb.core.layout.quantize import side_counts
 from quadcnn_wb.core.pipeline import mesh_domain
-from quadcnn_wb.core.quantize import side_counts
 
 MESHABLE_OWN = [name for name in OWN_SHAPES if name != "hexagon"]  # see the last test
 

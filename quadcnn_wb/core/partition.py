@@ -18,7 +18,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+from .layout.crossings import crossings
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
 
@@ -66,6 +67,7 @@ class Partition:
     edges: list
     blocks: list
     cuts: list  # extra polylines added so that every face is a disk
+    singular: tuple = ()  # vertex ids of singular points: never merged with another anchor
 
     def edge_points(self, e: int, forward: bool) -> np.ndarray:
         pts = self.edges[e].points
@@ -112,6 +114,13 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
             if curve.kind != "circle":
                 boundary_splits[li].add((si, 0.0))
     for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
+        # A singular point on the boundary itself (its separatrix there has no length) is
+        # that boundary vertex, not a second vertex in the same place.
+        if start.kind == "singularity" and end.kind in ("boundary", "corner") \
+                and _length(pts) <= 1e-6 * element_size:
+            verts.by_key.setdefault(("s", start.index), _end_vertex(
+                domain, verts, end, pts[-1], boundary_splits, k))
+    for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
         for where, end_point, pos in ((start, pts[0], 0.0), (end, pts[-1], None)):
             vid = _end_vertex(domain, verts, where, end_point, boundary_splits, k)
             if vid is None:
@@ -126,7 +135,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
             splits[other].append((s, vid))
             splits[k].append((_length(pts), vid))
     # Crossings between streamlines.
-    for n, ((i, si), (j, sj), xy) in enumerate(_crossings(lines, element_size, tol)):
+    for n, ((i, si), (j, sj), xy) in enumerate(crossings(lines, element_size, tol)):
         vid = verts.get(("x", n), xy)  # each crossing is found once
         splits[i].append((si, vid))
         splits[j].append((sj, vid))
@@ -139,7 +148,9 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
     from .subdivide import split_odd_faces
 
     vertices, blocks = split_odd_faces(verts.xy, edges, faces, domain, element_size)
-    return Partition(vertices=np.array(vertices), edges=edges, blocks=blocks, cuts=list(cuts))
+    singular = tuple(sorted(v for key, v in verts.by_key.items() if key[0] == "s"))
+    return Partition(vertices=np.array(vertices), edges=edges, blocks=blocks, cuts=list(cuts),
+                     singular=singular)
 
 
 def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
@@ -156,47 +167,6 @@ def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
 
 def _length(pts) -> float:
     return float(np.hypot(*np.diff(pts, axis=0).T).sum())
-
-
-def _crossings(lines, h, tol):
-    """Proper crossings between different streamlines (not at shared end points)."""
-    seg_a, seg_b, owner, s0 = [], [], [], []
-    for k, pts in enumerate(lines):
-        seg_a.append(pts[:-1])
-        seg_b.append(pts[1:])
-        owner.append(np.full(len(pts) - 1, k))
-        cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
-        s0.append(cum[:-1])
-    if not seg_a:
-        return []
-    a, b = np.concatenate(seg_a), np.concatenate(seg_b)
-    owner, s0 = np.concatenate(owner), np.concatenate(s0)
-    mid = 0.5 * (a + b)
-    half = 0.5 * np.hypot(*(b - a).T)
-    radius = 2 * float(half.max()) + tol
-    pairs = cKDTree(mid).query_pairs(radius, output_type="ndarray")
-    if not len(pairs):
-        return []
-    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
-    i, j = pairs[:, 0], pairs[:, 1]
-    d1, d2 = b[i] - a[i], b[j] - a[j]
-    den = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-    w = a[j] - a[i]
-    ok = np.abs(den) > 1e-300
-    t = np.where(ok, (w[:, 0] * d2[:, 1] - w[:, 1] * d2[:, 0]) / np.where(ok, den, 1), -1)
-    u = np.where(ok, (w[:, 0] * d1[:, 1] - w[:, 1] * d1[:, 0]) / np.where(ok, den, 1), -1)
-    hit = ok & (t >= 0) & (t < 1) & (u >= 0) & (u < 1)
-    out = []
-    ends = {k: (lines[k][0], lines[k][-1]) for k in range(len(lines))}
-    for pi, pj, tt, uu in zip(i[hit], j[hit], t[hit], u[hit]):
-        xy = a[pi] + tt * (b[pi] - a[pi])
-        near_end = any(np.hypot(*(xy - e)) < 0.5 * h for e in ends[owner[pi]] + ends[owner[pj]])
-        if near_end:
-            continue  # lines meeting at a shared end point, not crossing
-        si = s0[pi] + tt * np.hypot(*(b[pi] - a[pi]))
-        sj = s0[pj] + uu * np.hypot(*(b[pj] - a[pj]))
-        out.append(((int(owner[pi]), float(si)), (int(owner[pj]), float(sj)), xy))
-    return out
 
 
 def _split_line(pts, splits, k):

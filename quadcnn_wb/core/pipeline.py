@@ -16,11 +16,12 @@ import numpy as np
 from .cuts import connecting_cuts
 from .domain import Domain
 from .gmsh_quads import gmsh_quad_mesh
+from .layout.motorcycle import stop_at_first_hits
+from .layout.quantize import quantize
 from .partition import Partition, PartitionError, build_partition
 from .pose import diameter
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality, structured_share
-from .quantize import quantize
 from .reference import Reference, background_and_field
 from .tracing import trace_streamlines
 
@@ -110,6 +111,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     else:
         lines = trace_streamlines(domain, background, field)
         timings["tracing"] = time.perf_counter() - clock
+    lines = _t_mesh(domain, background, lines)
     problem = ""
     try:
         try:
@@ -122,6 +124,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
             clock = time.perf_counter()
             lines = tuple(dataclasses.replace(line, fallback=True)
                           for line in trace_streamlines(domain, background, field))
+            lines = _t_mesh(domain, background, lines)
             timings["fallback_tracing"] = time.perf_counter() - clock
             cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
@@ -143,6 +146,11 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
                       counts=counts, mesh=mesh, quality=quality, size=size, method=method,
                       fallback=fallback, timings=timings, structured=not problem,
                       problem=problem)
+
+
+def _t_mesh(domain, background, lines) -> tuple:
+    """Traces cut where they first meet an earlier one (see layout.motorcycle)."""
+    return stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
 
 
 def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings):

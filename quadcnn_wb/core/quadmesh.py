@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .layout.collapse import conflicts, merges, node_layout, side_nodes
 from .partition import Partition, PartitionError
 
 SMOOTH_ITERATIONS = 40
@@ -57,32 +58,37 @@ def _polyline_points(points: np.ndarray, n: int) -> np.ndarray:
 
 
 def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True) -> QuadMesh:
-    positions = [p for p in partition.vertices]
-    boundary_ids = set()
-    edge_nodes = []
+    layout = node_layout(partition, counts)
+    found = merges(partition, layout, counts)
+    if conflicts(layout, found):
+        raise PartitionError("the segment counts merge two boundary nodes or singular points")
+    raw = np.zeros((layout.n_nodes, 2))
+    raw[: len(partition.vertices)] = partition.vertices
     for e, edge in enumerate(partition.edges):
         n = int(counts[e])
-        if edge.is_boundary:
-            pts = _boundary_edge_points(domain, edge, n)
-        else:
-            pts = _polyline_points(edge.points, n)
-        ids = [edge.a]
-        for p in pts[1:-1]:
-            ids.append(len(positions))
-            positions.append(p)
-        ids.append(edge.b)
-        if edge.is_boundary:
-            boundary_ids.update(ids)
-        edge_nodes.append(np.array(ids))
+        if n == 0:
+            continue
+        pts = _boundary_edge_points(domain, edge, n) if edge.is_boundary \
+            else _polyline_points(edge.points, n)
+        raw[layout.edge_nodes[e][1:-1]] = pts[1:-1]
+    # A merged place: the boundary node if it holds one (boundary nodes never move), else
+    # the mean of what was merged (two side-by-side separatrices meet half-way).
+    root = found.parent
+    used = np.unique(root)
+    compact = np.full(layout.n_nodes, -1, dtype=np.int64)
+    compact[used] = np.arange(len(used))
+    ids = compact[root]
+    total = np.zeros((len(used), 2))
+    np.add.at(total, ids, raw)
+    positions = list(total / np.bincount(ids, minlength=len(used))[:, None])
+    boundary_ids = set(ids[layout.boundary].tolist())
+    for x in np.nonzero(layout.boundary)[0]:
+        positions[ids[x]] = raw[x]
     quads, owner = [], []
     for b, block in enumerate(partition.blocks):
-        sides = []
-        for side in block.sides:
-            ids = []
-            for e, forward in side:
-                part = edge_nodes[e] if forward else edge_nodes[e][::-1]
-                ids.extend(part if not ids else part[1:])
-            sides.append(np.array(ids))
+        if b in found.collapsed:
+            continue
+        sides = [ids[side_nodes(layout, counts, side)] for side in block.sides]
         n, m = len(sides[0]) - 1, len(sides[1]) - 1
         if len(sides[2]) - 1 != n or len(sides[3]) - 1 != m:
             raise PartitionError(f"block {b}: opposite sides have {n}/{len(sides[2]) - 1} and "
@@ -104,13 +110,18 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     nodes = np.array(positions, dtype=float)
     quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
     owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
+    if len(quads) and (np.sort(quads, axis=1)[:, 1:] == np.sort(quads, axis=1)[:, :-1]).any():
+        raise PartitionError("the segment counts squash a block into a quad with a repeated "
+                             "corner")
     boundary = np.zeros(len(nodes), dtype=bool)
     boundary[list(boundary_ids)] = True
     quads = _counter_clockwise(nodes, quads)
     if smoothing:
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
+    edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
+                       for e, e_nodes in enumerate(layout.edge_nodes))
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
-                    edge_nodes=tuple(edge_nodes))
+                    edge_nodes=edge_nodes)
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:

@@ -1,0 +1,1 @@
+"""Layout stage: from traced streamlines to blocks (T-mesh, segment counts, cuts)."""

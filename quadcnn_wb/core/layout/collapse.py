@@ -1,0 +1,139 @@
+"""Which mesh nodes become one when segment counts are zero.
+
+An arc of the T-mesh with no segments has its two ends in one place; a block whose two
+opposite sides have no segments is a strip of no width, so its other two sides are one
+mesh line, node for node.  That is how separatrices running side by side become one mesh
+line and thin strips vanish.  It must never pinch the domain: two boundary nodes, a
+boundary node and a singular point, or two singular points in one place are a conflict,
+reported with the merges that caused it, so that the segment-count program can forbid
+one of them (quantize.py) and the mesh builder never meets one.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class NodeLayout:
+    """Raw node ids: partition vertices first, then each edge's inner nodes."""
+
+    edge_nodes: list  # per edge, node ids from vertex a to vertex b (count + 1 of them)
+    n_nodes: int
+    boundary: np.ndarray  # raw node on the domain boundary
+    anchor: np.ndarray  # raw node that may not share a place with another anchor
+
+
+def node_layout(partition, counts) -> NodeLayout:
+    n = len(partition.vertices)
+    edge_nodes = []
+    boundary_ids = []
+    for e, edge in enumerate(partition.edges):
+        k = int(counts[e])
+        inner = np.arange(n, n + max(k - 1, 0))
+        n += len(inner)
+        ids = np.concatenate([[edge.a], inner, [edge.b]]).astype(np.int64)
+        edge_nodes.append(ids)
+        if edge.is_boundary:
+            boundary_ids.append(ids)
+    boundary = np.zeros(n, dtype=bool)
+    if boundary_ids:
+        boundary[np.concatenate(boundary_ids)] = True
+    anchor = boundary.copy()
+    anchor[list(partition.singular)] = True
+    return NodeLayout(edge_nodes, n, boundary, anchor)
+
+
+def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
+    """Raw node ids along a block side: one per segment end (zero-count arcs add none)."""
+    first_e, first_fwd = side[0]
+    start = layout.edge_nodes[first_e][0 if first_fwd else -1]
+    ids = [int(start)]
+    for e, forward in side:
+        if int(counts[e]) == 0:
+            continue
+        part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
+        ids.extend(int(i) for i in part[1:])
+    return np.array(ids, dtype=np.int64)
+
+
+@dataclass
+class Merges:
+    parent: np.ndarray  # canonical raw id of every raw node
+    links: list  # (u, v, reason): reason ("edge", e) or ("block", b, pair)
+    collapsed: set  # blocks of no area
+
+
+def merges(partition, layout: NodeLayout, counts) -> Merges:
+    parent = np.arange(layout.n_nodes)
+
+    def find(x):
+        root = x
+        while parent[root] != root:
+            root = parent[root]
+        while parent[x] != root:
+            parent[x], x = root, parent[x]
+        return root
+
+    links = []
+    for e, edge in enumerate(partition.edges):
+        if int(counts[e]) == 0:
+            links.append((int(edge.a), int(edge.b), ("edge", e)))
+    collapsed = set()
+    for b, block in enumerate(partition.blocks):
+        sides = [side_nodes(layout, counts, side) for side in block.sides]
+        for pair in (0, 1):
+            if len(sides[pair]) == 1:  # no segments across: the other two sides are one
+                collapsed.add(b)
+                other, opposite = sides[pair + 1], sides[(pair + 3) % 4][::-1]
+                if len(other) != len(opposite):
+                    continue  # unequal sides: the counts are not a solution; caught later
+                links.extend((int(u), int(v), ("block", b, pair))
+                             for u, v in zip(other, opposite) if u != v)
+    for u, v, _ in links:
+        ru, rv = find(u), find(v)
+        if ru != rv:
+            parent[max(ru, rv)] = min(ru, rv)
+    for x in range(layout.n_nodes):
+        find(x)
+    return Merges(parent, links, collapsed)
+
+
+def conflicts(layout: NodeLayout, found: Merges) -> list:
+    """For every place where two anchors were merged, the merges on a path between them."""
+    out = []
+    groups: dict = {}
+    for x in np.nonzero(layout.anchor)[0]:
+        groups.setdefault(int(found.parent[x]), []).append(int(x))
+    adjacency: dict = {}
+    for u, v, reason in found.links:
+        adjacency.setdefault(u, []).append((v, reason))
+        adjacency.setdefault(v, []).append((u, reason))
+    for root in sorted(groups):
+        anchors = groups[root]
+        if len(anchors) < 2:
+            continue
+        out.append(_path_reasons(adjacency, anchors[0], set(anchors[1:])))
+    return out
+
+
+def _path_reasons(adjacency, source, targets) -> list:
+    """Reasons along a shortest merge path from source to any of targets."""
+    came = {source: None}
+    queue = deque([source])
+    while queue:
+        x = queue.popleft()
+        if x in targets:
+            reasons = []
+            while came[x] is not None:
+                x, reason = came[x]
+                reasons.append(reason)
+            return sorted(set(reasons))
+        for y, reason in adjacency.get(x, ()):
+            if y not in came:
+                came[y] = (x, reason)
+                queue.append(y)
+    return []
