@@ -19,13 +19,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .layout.crossings import crossings
+from .layout.crossings import crossings, end_places
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
 
 
 class PartitionError(RuntimeError):
-    """The streamlines do not cut the domain into four-sided blocks."""
+    """The streamlines do not cut the domain into four-sided blocks.
+
+    ``outline`` (when known) is the offending face's boundary, ``corners`` its corner
+    points, for pictures of what went wrong."""
+
+    def __init__(self, message, outline=None, corners=None):
+        super().__init__(message)
+        self.outline = outline
+        self.corners = corners
 
 
 @dataclass(frozen=True)
@@ -135,7 +143,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
             splits[other].append((s, vid))
             splits[k].append((_length(pts), vid))
     # Crossings between streamlines.
-    for n, ((i, si), (j, sj), xy) in enumerate(crossings(lines, element_size, tol)):
+    for n, ((i, si), (j, sj), xy) in enumerate(crossings(lines, element_size, tol,
+                                                        [end_places(s) for s in every])):
         vid = verts.get(("x", n), xy)  # each crossing is found once
         splits[i].append((si, vid))
         splits[j].append((sj, vid))
@@ -306,6 +315,9 @@ def _block_of(cycle, half, edges, vertices, h, head):
         turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
         turns.append(turn)
     turns = np.array(turns)
+    outline = np.vstack([edges[e].points if f else edges[e].points[::-1]
+                         for e, f in (half[c] for c in cycle)])
+    tips = np.array([vertices[head(c)] for c in cycle])
     if np.any(turns < -CORNER_TURN):
         k = int(np.argmin(turns))
         raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
@@ -314,7 +326,7 @@ def _block_of(cycle, half, edges, vertices, h, head):
     if len(corner_at) not in (3, 4, 5):
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
         raise PartitionError(f"a block near {_fmt(centre)} has {len(corner_at)} corners "
-                             f"instead of 4")
+                             f"instead of 4", outline, tips[corner_at])
     n_sides = len(corner_at)
     sides = []
     corners = []

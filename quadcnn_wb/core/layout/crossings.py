@@ -11,15 +11,30 @@ def cumulative_length(points: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
 
 
-def crossings(lines, h: float, tol: float, end_clearance: float = 0.5, ends=None,
-              shared_ends_only: bool = False) -> list:
+def end_places(line) -> list:
+    """(point, places) at both ends of a streamline: the singular point or corner it leaves
+    or reaches, or ("line", j) when it ends on line j."""
+    out = []
+    for where, point in ((line.start, line.points[0]), (line.end, line.points[-1])):
+        if where.kind == "singularity":
+            out.append((point, {("s", where.index)}))
+        elif where.kind == "corner":
+            out.append((point, {("c", where.index)}))
+        elif where.kind == "streamline":
+            out.append((point, {("line", where.index)}))
+        else:
+            out.append((point, set()))
+    return out
+
+
+def crossings(lines, h: float, tol: float, ends, end_clearance: float = 0.5) -> list:
     """Proper crossings ((i, s_i), (j, s_j), xy) between different polylines.
 
-    A crossing within ``end_clearance`` element sizes of an end of either line is where
-    lines meet at a shared end point (a singular point they both leave), not a crossing.
-    ``ends`` (per line, the points that count as its ends) defaults to both end points.
-    With ``shared_ends_only`` the crossing must be near an end of both lines to be left
-    out: a line passing close by another's foot on the boundary does cross it.
+    ``ends[k]`` lists (point, places) of line k's ends (see end_places).  Where two lines
+    leave or reach the same singular point or corner, or one ends on the other, they meet
+    there without crossing: a crossing within ``end_clearance`` element sizes of such a
+    shared end is left out.  Any other crossing counts, however near an end it lies (a
+    line passing close by another's foot on the boundary does cross it).
     """
     seg_a, seg_b, owner, s0 = [], [], [], []
     for k, pts in enumerate(lines):
@@ -48,14 +63,15 @@ def crossings(lines, h: float, tol: float, end_clearance: float = 0.5, ends=None
     u = np.where(ok, (w[:, 0] * d1[:, 1] - w[:, 1] * d1[:, 0]) / np.where(ok, den, 1), -1)
     hit = ok & (t >= 0) & (t < 1) & (u >= 0) & (u < 1)
     out = []
-    if ends is None:
-        ends = [(pts[0], pts[-1]) for pts in lines]
-    ends = {k: tuple(e) for k, e in enumerate(ends)}
+    reach = end_clearance * h
     for pi, pj, tt, uu in zip(i[hit], j[hit], t[hit], u[hit]):
         xy = a[pi] + tt * (b[pi] - a[pi])
-        near_i = any(np.hypot(*(xy - e)) < end_clearance * h for e in ends[owner[pi]])
-        near_j = any(np.hypot(*(xy - e)) < end_clearance * h for e in ends[owner[pj]])
-        if (near_i and near_j) if shared_ends_only else (near_i or near_j):
+        li, lj = int(owner[pi]), int(owner[pj])
+        near_i = set().union(*([places for point, places in ends[li]
+                                if np.hypot(*(xy - point)) < reach] or [set()]))
+        near_j = set().union(*([places for point, places in ends[lj]
+                                if np.hypot(*(xy - point)) < reach] or [set()]))
+        if ("line", lj) in near_i or ("line", li) in near_j or near_i & near_j:
             continue
         si = s0[pi] + tt * np.hypot(*(b[pi] - a[pi]))
         sj = s0[pj] + uu * np.hypot(*(b[pj] - a[pj]))

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..tracing import Endpoint
-from .crossings import crossings, cumulative_length
+from .crossings import crossings, cumulative_length, end_places
 
 SOURCE_KINDS = ("singularity", "corner")
 
@@ -89,12 +89,9 @@ def stop_at_first_hits(lines, h: float, tol: float) -> tuple:
             j, s = _rider_at(riders, by_line, line.end.index,
                              line.end.param * length[line.end.index], length[line.end.index])
             riders[j].keep_to = max(riders[j].keep_to, s)
-    # A rider's inner end (the middle of a two-ended line) is no end where lines meet.
-    real_ends = [[r.points[0]] + ([] if len(by_line[r.line]) == 2 else [r.points[-1]])
-                 for r in riders]
+    ends = _rider_ends(lines, riders, by_line)
     events = []
-    for (i, si), (j, sj), xy in crossings([r.points for r in riders], h, tol, ends=real_ends,
-                                               shared_ends_only=True):
+    for (i, si), (j, sj), xy in crossings([r.points for r in riders], h, tol, ends):
         if si > sj:
             events.append((si, i, j, sj, xy))
         elif sj > si:
@@ -156,3 +153,20 @@ def _length(line) -> float:
 
 def _fraction(s: float, length: float) -> float:
     return min(max(s / length, 0.0), 1.0) if length > 0 else 0.0
+
+
+def _rider_ends(lines, riders, by_line) -> list:
+    """(point, places) at a rider's two ends, in rider terms: a junction onto line j is a
+    junction onto both of j's riders; the two halves of a line meet in its middle."""
+    out = []
+    for r in riders:
+        (p0, at_start), (p1, at_end) = end_places(lines[r.line])
+        if r.backward:
+            (p0, at_start), (p1, at_end) = (p1, at_end), (p0, at_start)
+        if len(by_line[r.line]) == 2:
+            far = (r.points[-1], {("mid", r.line)})
+        else:
+            far = (p1, {("line", k) for kind, j in at_end if kind == "line"
+                        for k in by_line[j]} | {x for x in at_end if x[0] != "line"})
+        out.append([(p0, {x for x in at_start if x[0] != "line"}), far])
+    return out
