@@ -21,7 +21,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # No block partition yet (issue 15's T-mesh partition and quantization): gmsh stands in.
-NO_BLOCKS_YET = {"anc101_flange", "as1_plate", "housing_rib", "nist_ctc01_plate",
+NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
                  "nist_ctc04_plate", "tailwheel_gusset", "crank_arm_web", "engine_bottom",
                  "engine_top", "motor_c_plate", "io1_flange", "bracket_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
@@ -76,3 +76,13 @@ def test_every_face_is_block_structured(name):
     result = meshed(name)
     assert result.structured_share == 1.0, result.problem
     assert result.quality["irregular_vertices"] <= len(result.reference.field.singularities) + 4
+
+
+def test_a_face_without_blocks_says_so():
+    # While some faces still get no block partition, the stand-in must say so everywhere.
+    name = sorted(NO_BLOCKS_YET - INVALID_STAND_IN)[0]
+    result = meshed(name)
+    assert not result.structured and "no block structure" in result.problem
+    data = result.to_json()
+    assert data["structured"] is False and data["structured_share"] == 0.0
+    assert data["problem"] == result.problem
