@@ -8,14 +8,17 @@ curve).  Faces are walked with half-edges, the face on the left of each.  A bloc
 is a vertex where the face's boundary turns by more than 45° (about 90° on a field-aligned
 partition); a straight-through vertex (a T-junction, a streamline foot) only splits a side
 into several edges.  A loop that no streamline reaches (an annulus's hole) first gets a
-cut along a field line, so every face is a disk.  Anything else than four corners and no
-reflex turn is refused: a PartitionError, never a silent bad mesh.
+cut along a field line, so every face is a disk.  A face with other than four corners or
+with a reflex turn is no block: it is kept as a free face with the reason (the mesh builder
+fills it with unstructured quads that conform to the blocks around it, free_faces.py), so
+one bad face no longer costs the whole domain its blocks.  Only what breaks the arrangement
+itself (a zero-length edge, a walk that never closes) is a PartitionError.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -69,6 +72,14 @@ class Block:
     sides: tuple  # four tuples of (edge id, forward) from corner k to corner k+1
 
 
+@dataclass(frozen=True)
+class FreeFace:
+    """A face of the arrangement that is no four-sided block, and why."""
+
+    halves: tuple  # (edge id, forward) around the face, the face on the left
+    reason: str
+
+
 @dataclass
 class Partition:
     vertices: np.ndarray  # (V, 2)
@@ -76,6 +87,7 @@ class Partition:
     blocks: list
     cuts: list  # extra polylines added so that every face is a disk
     singular: tuple = ()  # vertex ids of singular points: never merged with another anchor
+    free_faces: list = field(default_factory=list)  # FreeFace: unstructured quads there
 
     def edge_points(self, e: int, forward: bool) -> np.ndarray:
         pts = self.edges[e].points
@@ -153,13 +165,84 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
         edges.extend(_split_line(pts, splits[k], k))
     for li in range(len(domain.loops)):
         edges.extend(_boundary_edges(domain, li, sorted(boundary_splits[li]), verts))
-    faces = _faces_to_blocks(np.array(verts.xy), edges, element_size)
+    edges = _without_dangling(_without_doubles(edges, element_size))
+    while True:
+        faces, free = _faces_to_blocks(np.array(verts.xy), edges, element_size)
+        slits = _slits(free, edges)
+        if not slits:
+            break
+        edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
     from .subdivide import split_odd_faces
 
-    vertices, blocks = split_odd_faces(verts.xy, edges, faces, domain, element_size)
+    vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
     singular = tuple(sorted(v for key, v in verts.by_key.items() if key[0] == "s"))
     return Partition(vertices=np.array(vertices), edges=edges, blocks=blocks, cuts=list(cuts),
-                     singular=singular)
+                     singular=singular, free_faces=free)
+
+
+DOUBLE_EDGE_GAP = 0.5  # two edges of the same ends closer than this (element sizes) are one
+
+
+def _without_doubles(edges, h) -> list:
+    """One edge where two join the same vertices side by side: two separatrices leaving a
+    point together and one stopping on the other a step later make a sliver of no width,
+    which no face walk can order (their directions at the vertex are the same).  The
+    boundary edge, else the earlier streamline's, stays."""
+    by_ends: dict = {}
+    for e, edge in enumerate(edges):
+        if edge.a != edge.b:
+            by_ends.setdefault(frozenset((edge.a, edge.b)), []).append(e)
+    dropped = set()
+    for group in by_ends.values():
+        group.sort(key=lambda e: (not edges[e].is_boundary, edges[e].streamline, e))
+        for i, keep in enumerate(group):
+            if keep in dropped:
+                continue
+            for other in group[i + 1:]:
+                if other not in dropped and not edges[other].is_boundary \
+                        and _side_by_side(edges[keep], edges[other], DOUBLE_EDGE_GAP * h):
+                    dropped.add(other)
+    return [edge for e, edge in enumerate(edges) if e not in dropped]
+
+
+def _side_by_side(first: Edge, second: Edge, gap: float) -> bool:
+    a = _resampled(first.points, 9)
+    b = _resampled(second.points if second.a == first.a else second.points[::-1], 9)
+    return bool(np.hypot(*(a - b).T).max() <= gap)
+
+
+def _resampled(points, n: int) -> np.ndarray:
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    return np.array([_at(points, cum, s) for s in np.linspace(0.0, cum[-1], n)])
+
+
+def _without_dangling(edges) -> list:
+    """Streamline edges with an end on nothing else (left by _without_doubles, or a trace
+    that stopped in the open) bound no face: dropped, repeatedly."""
+    edges = list(edges)
+    while True:
+        degree: dict = {}
+        for edge in edges:
+            for v in (edge.a, edge.b):
+                degree[v] = degree.get(v, 0) + 1
+        keep = [edge for edge in edges if edge.is_boundary
+                or (degree[edge.a] > 1 and degree[edge.b] > 1)]
+        if len(keep) == len(edges):
+            return edges
+        edges = keep
+
+
+def _slits(free, edges) -> set:
+    """Streamline edges with a free face on both sides: they separate nothing, and a face
+    with a slit is no polygon to fill; without them the face is one."""
+    out = set()
+    for face in free:
+        seen = set()
+        for e, _ in face.halves:
+            if e in seen and not edges[e].is_boundary:
+                out.add(e)
+            seen.add(e)
+    return out
 
 
 def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
@@ -283,7 +366,7 @@ def _faces_to_blocks(vertices, edges, h):
         return items[(k - 1) % len(items)][1]
 
     seen = set()
-    blocks = []
+    blocks, free = [], []
     for start in range(len(half)):
         if start in seen:
             continue
@@ -297,8 +380,11 @@ def _faces_to_blocks(vertices, edges, h):
                 raise PartitionError("the arrangement of streamlines is not planar")
         if any(edges[half[c][0]].is_boundary and not half[c][1] for c in cycle):
             continue  # outside the domain (the outer face, or inside a hole)
-        blocks.append(_block_of(cycle, half, edges, vertices, h, head))
-    return blocks
+        try:
+            blocks.append(_block_of(cycle, half, edges, vertices, h, head))
+        except PartitionError as exc:
+            free.append(FreeFace(tuple(half[c] for c in cycle), str(exc)))
+    return blocks, free
 
 
 def _block_of(cycle, half, edges, vertices, h, head):

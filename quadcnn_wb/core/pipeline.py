@@ -18,7 +18,7 @@ from .domain import Domain
 from .gmsh_quads import gmsh_quad_mesh
 from .layout.motorcycle import stop_at_first_hits
 from .layout.quantize import quantize
-from .partition import Partition, PartitionError, build_partition
+from .partition import FreeFace, Partition, PartitionError, build_partition
 from .pose import diameter
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality, structured_share
@@ -115,8 +115,9 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     problem = ""
     try:
         try:
-            cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
-                                                             size, smoothing, timings)
+            cuts, partition, counts, mesh = _blocks_and_mesh(
+                domain, background, field, lines, size, smoothing, timings,
+                allow_free=method != "cnn")
         except PartitionError:
             if method != "cnn":
                 raise
@@ -136,6 +137,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
         clock = time.perf_counter()
         mesh = gmsh_quad_mesh(domain, size)
         timings["quad_mesh"] = time.perf_counter() - clock
+    problem = problem or free_face_problem(partition)
     clock = time.perf_counter()
     quality = mesh_quality(domain, mesh)
     timings["quality"] = time.perf_counter() - clock
@@ -153,19 +155,35 @@ def _t_mesh(domain, background, lines) -> tuple:
     return stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
 
 
-def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings):
-    """Partition, segment counts and the block-structured mesh, checked; PartitionError
-    when any of them cannot be had from these streamlines."""
+FREEING_ROUNDS = 3  # blocks whose map folds are handed to the free-face mesher this often
+
+
+def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
+                     allow_free=True):
+    """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
+    can be had from these streamlines.  Faces that are no blocks, and blocks whose map
+    gives a degenerate element, get unstructured quads (free faces) unless ``allow_free``
+    is False (the cnn path: its lines are then not trusted)."""
     clock = time.perf_counter()
     cuts, partition = _partition(domain, background, field, lines)
     timings["partition"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    counts = quantize(partition, size)
-    timings["quantization"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
-    timings["quad_mesh"] = time.perf_counter() - clock
-    worst = scaled_jacobians(mesh.nodes, mesh.quads).min() if len(mesh.quads) else 0.0
+    if partition.free_faces and not allow_free:
+        raise PartitionError(partition.free_faces[0].reason)
+    timings["quantization"] = timings["quad_mesh"] = 0.0
+    for round_ in range(FREEING_ROUNDS + 1):
+        clock = time.perf_counter()
+        counts = quantize(partition, size)
+        timings["quantization"] += time.perf_counter() - clock
+        clock = time.perf_counter()
+        mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
+        timings["quad_mesh"] += time.perf_counter() - clock
+        sj = scaled_jacobians(mesh.nodes, mesh.quads)
+        folded = sorted({int(b) for b in mesh.block_of_quad[sj <= MIN_VALID_JACOBIAN]
+                         if b >= 0})
+        if not folded or not allow_free or round_ == FREEING_ROUNDS:
+            break
+        partition = free_blocks(partition, folded)
+    worst = sj.min() if len(sj) else 0.0
     if worst <= MIN_VALID_JACOBIAN:
         raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
                              f"{worst:.3f})")
@@ -174,6 +192,25 @@ def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings)
     if not free_edges_on_boundary(mesh.quads, mesh.boundary):
         raise PartitionError("the blocks leave a gap inside the domain")
     return cuts, partition, counts, mesh
+
+
+def free_blocks(partition: Partition, blocks) -> Partition:
+    """The partition with these blocks turned into free faces."""
+    chosen = set(blocks)
+    kept = [b for k, b in enumerate(partition.blocks) if k not in chosen]
+    freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side),
+                      "a block map gives a degenerate element") for k in sorted(chosen)]
+    return dataclasses.replace(partition, blocks=kept,
+                               free_faces=list(partition.free_faces) + freed)
+
+
+def free_face_problem(partition: Partition) -> str:
+    """What the result says when some faces got unstructured quads."""
+    if not partition.free_faces:
+        return ""
+    reasons = sorted({face.reason.split(" near ")[0] for face in partition.free_faces})
+    return (f"{len(partition.free_faces)} of {len(partition.free_faces) + len(partition.blocks)}"
+            f" faces are no blocks ({'; '.join(reasons)}): unstructured quads there")
 
 
 def free_edges_on_boundary(quads, boundary) -> bool:

@@ -3,8 +3,10 @@ by transfinite (Coons) interpolation, then smoothed without ever inverting an el
 
 Edges are shared by the blocks on both sides, so the mesh is conforming by construction;
 nodes on boundary edges are placed on the exact curves (arc-length spacing) and never
-move.  Interior nodes, including those on streamline edges and at singular points, are
-smoothed (Laplacian) under a guard that undoes any move that would make a quad's scaled
+move.  Free faces (no blocks, see partition.py) get gmsh's unstructured quads on the
+side nodes their neighbours use (free_faces.py); their quads belong to block -1.  Interior
+nodes, including those on streamline edges and at singular points, are smoothed
+(Laplacian) under a guard that undoes any move that would make a quad's scaled
 Jacobian drop below the smaller of its current value and SMOOTH_FLOOR.
 """
 
@@ -14,8 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .free_faces import free_face_quads
 from .layout.collapse import conflicts, merges, node_layout, side_nodes
 from .partition import Partition, PartitionError
+from .pose import canonical_pose
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3
@@ -107,6 +111,12 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
         q = np.stack([grid[:-1, :-1], grid[1:, :-1], grid[1:, 1:], grid[:-1, 1:]], axis=-1)
         quads.append(q.reshape(-1, 4))
         owner.append(np.full(n * m, b))
+    if partition.free_faces:
+        pose = canonical_pose(domain)
+        for face in partition.free_faces:
+            q = _free_face(layout, ids, positions, face, pose)
+            quads.append(q)
+            owner.append(np.full(len(q), -1))
     nodes = np.array(positions, dtype=float)
     quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
     owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
@@ -122,6 +132,22 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
                        for e, e_nodes in enumerate(layout.edge_nodes))
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
                     edge_nodes=edge_nodes)
+
+
+def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
+    """Quads of one free face (global node ids); its interior points join positions."""
+    ring = []
+    for e, forward in face.halves:
+        part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
+        ring.extend(int(i) for i in ids[part[:-1]])
+    ring = np.array(ring, dtype=np.int64)
+    if len(np.unique(ring)) != len(ring):
+        raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
+    interior, local = free_face_quads(np.array(positions)[ring], pose)
+    first = len(positions)
+    positions.extend(interior)
+    return np.where(local < len(ring), ring[np.minimum(local, len(ring) - 1)],
+                    local - len(ring) + first)
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:

@@ -5,32 +5,40 @@ nearly coincide, a face of the streamline arrangement can come out with 3 or 5 c
 Midpoint subdivision turns a k-cornered face into k blocks meeting at its centre: every
 side is cut at its middle (the neighbouring block just gets a T-junction there) and joined
 to the centre.  The centre becomes one extra irregular vertex (valence k), which is the
-price of a block-structured mesh there.
+price of a block-structured mesh there.  A face too concave for that stays a free face
+(unstructured quads, see free_faces.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .partition import Block, BoundaryPiece, Edge, PartitionError, _fmt
+from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
 
-def split_odd_faces(vertices: list, edges: list, faces: list, domain, h):
-    """(vertex list, blocks): four-cornered faces as they are, others subdivided."""
+def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain):
+    """(vertex list, blocks, free faces): four-cornered faces as they are, others
+    subdivided; free faces follow the edges split on their way."""
     vertices = list(vertices)
     odd = [f for f in faces if len(f[0]) != 4]
     blocks = []
+    free_halves = [(list(f.halves), f.reason) for f in free]
+    everything = list(faces) + [(None, [halves]) for halves, _ in free_halves]
     for corners, sides in odd:
         mids = []
         for j in range(len(sides)):
-            mids.append(_split_side(vertices, edges, faces, sides, j, domain))
+            mids.append(_split_side(vertices, edges, everything, sides, j, domain))
         centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
         polygon = np.array([vertices[c] for c in corners])
         if not _inside_polygon(polygon, centre):
-            raise PartitionError(f"a {len(corners)}-cornered block near {_fmt(centre)} is "
-                                 "too concave to split into quadrilaterals")
+            halves = [h for side in sides for h in side]
+            free_halves.append((halves, f"a {len(corners)}-cornered block near "
+                                f"{_fmt(centre)} is too concave to split into "
+                                "quadrilaterals"))
+            everything.append((None, [halves]))
+            continue
         c_id = len(vertices)
         vertices.append(centre)
         spokes = []
@@ -49,7 +57,7 @@ def split_odd_faces(vertices: list, edges: list, faces: list, domain, h):
     for corners, sides in faces:
         if len(corners) == 4:
             blocks.append(Block(corners=tuple(corners), sides=tuple(tuple(s) for s in sides)))
-    return vertices, blocks
+    return vertices, blocks, [FreeFace(tuple(h), reason) for h, reason in free_halves]
 
 
 def _head(edges, half):

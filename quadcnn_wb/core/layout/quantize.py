@@ -58,7 +58,8 @@ def geometric_order(partition: Partition, size: float) -> np.ndarray:
     return np.array(sorted(range(len(keys)), key=lambda e: keys[e]), dtype=np.int64)
 
 
-def _secant_rows(target: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> LinearConstraint:
+def _secant_rows(target: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                 n_columns: int) -> LinearConstraint:
     """c_e - slope_k n_e >= f(k) - slope_k k for every secant of f(n) = (n - target_e)^2
     through n = k, k + 1 (k = lower_e .. upper_e - 1): at integer n the largest is f(n)."""
     n_edges = len(target)
@@ -69,25 +70,46 @@ def _secant_rows(target: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> Li
     rows = np.arange(len(k))
     matrix = coo_matrix((np.concatenate([-slope, np.ones(len(k))]),
                          (np.concatenate([rows, rows]), np.concatenate([edge, n_edges + edge]))),
-                        shape=(len(k), 2 * n_edges))
+                        shape=(len(k), n_columns))
     return LinearConstraint(matrix.tocsr(), (k - t) ** 2 - slope * k, np.inf)
 
 
+def _rows(entries: list, n_columns: int):
+    """Sparse matrix of rows given as {column: coefficient}."""
+    matrix = lil_matrix((len(entries), n_columns))
+    for r, row in enumerate(entries):
+        for column, value in row.items():
+            matrix[r, column] += value
+    return matrix.tocsr()
+
+
 MAX_ROUNDS = 30  # conflict rows added one solve at a time
+MIN_FREE_FACE_HALVES = 3  # a free face's outline at half resolution: at least a triangle
 
 
 def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.ndarray:
-    """Integer segment count per edge of the partition (0 allowed on streamline arcs)."""
+    """Integer segment count per edge of the partition (0 allowed on streamline arcs).
+
+    Edges of free faces get an even count of at least 2 (n_e = 2 m_e): their quads come
+    from a mesh of the face at half resolution, subdivided (free_faces.py).  Evenness
+    keeps the program feasible: the block equalities are homogeneous, so twice any
+    solution is a solution, and a free face is constrained by nothing else.
+    """
     n_edges = len(partition.edges)
     if n_edges == 0:
         return np.zeros(0, dtype=int)
     order = geometric_order(partition, size)
     position = np.empty(n_edges, dtype=np.int64)
     position[order] = np.arange(n_edges)  # edge e is variable position[e]
+    free_edges = sorted({int(position[e]) for face in partition.free_faces
+                         for e, _ in face.halves})
+    half_of = {v: 2 * n_edges + k for k, v in enumerate(free_edges)}  # m_e's column
+    n_columns = 2 * n_edges + len(free_edges)
     # Rounded: a turned or rescaled copy must pose the very same problem (near-ties at
     # n + 0.5 would otherwise be broken by rounding noise).
     target = np.round(np.array([partition.edges[e].length / size for e in order]), 9)
     lower = np.array([1 if partition.edges[e].is_boundary else 0 for e in order])
+    lower[free_edges] = 2
     equalities = []  # (variable positions with +1, with -1), in a geometric order too
     for block in partition.blocks:
         for pair in (0, 1):
@@ -95,29 +117,36 @@ def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.
             minus = sorted(int(position[e]) for e, _ in block.sides[pair + 2])
             equalities.append((plus, minus) if plus < minus else (minus, plus))
     equalities.sort()
-    rows = lil_matrix((len(equalities), 2 * n_edges))
-    for r, (plus, minus) in enumerate(equalities):
+    rows = []
+    for plus, minus in equalities:
+        row: dict = {}
         for v in plus:
-            rows[r, v] += 1
+            row[v] = row.get(v, 0) + 1
         for v in minus:
-            rows[r, v] -= 1
+            row[v] = row.get(v, 0) - 1
+        rows.append(row)
+    rows.extend({v: 1, half_of[v]: -2} for v in free_edges)
     upper = np.maximum(4 * np.ceil(target) + 4, 8).astype(int)
-    constraints = [_secant_rows(target, lower, upper)]
-    if partition.blocks:
-        constraints.append(LinearConstraint(rows.tocsr(), 0, 0))
-    cost = np.concatenate([np.zeros(n_edges), np.ones(n_edges)])
-    integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges)])
-    bounds = Bounds(np.concatenate([lower, np.zeros(n_edges)]),
-                    np.concatenate([upper, np.full(n_edges, np.inf)]))
+    constraints = [_secant_rows(target, lower, upper, n_columns)]
+    if rows:
+        constraints.append(LinearConstraint(_rows(rows, n_columns), 0, 0))
+    if partition.free_faces:
+        at_least = [{half_of[int(position[e])]: 1 for e, _ in face.halves}
+                    for face in partition.free_faces]
+        constraints.append(LinearConstraint(_rows(at_least, n_columns),
+                                            MIN_FREE_FACE_HALVES, np.inf))
+    cost = np.concatenate([np.zeros(n_edges), np.ones(n_edges), np.zeros(len(free_edges))])
+    integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges),
+                                  np.ones(len(free_edges))])
+    bounds = Bounds(np.concatenate([lower, np.zeros(n_edges), np.ones(len(free_edges))]),
+                    np.concatenate([upper, np.full(n_edges, np.inf),
+                                    np.full(len(free_edges), np.inf)]))
     forbidden = []  # rows: at least one segment among these variables
     for _ in range(MAX_ROUNDS):
         extra = []
         if forbidden:
-            matrix = lil_matrix((len(forbidden), 2 * n_edges))
-            for r, variables in enumerate(forbidden):
-                for v in variables:
-                    matrix[r, v] += 1
-            extra = [LinearConstraint(matrix.tocsr(), 1, np.inf)]
+            extra = [LinearConstraint(_rows([dict.fromkeys(f, 1) for f in forbidden],
+                                            n_columns), 1, np.inf)]
         result = milp(cost, constraints=constraints + extra, integrality=integrality,
                       bounds=bounds, options={"time_limit": time_limit})
         if result.x is None:

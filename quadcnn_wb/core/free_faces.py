@@ -1,0 +1,142 @@
+"""Unstructured quads for the faces of a partition that are no blocks.
+
+A face with other than four corners, or one that turns back, cannot take a structured
+map; rather than give up the blocks of the whole domain for it, only that face is filled
+by gmsh, with the nodes its neighbours already put on its sides, so the mesh stays
+conforming.  gmsh's all-quad route is a triangle/quad mesh recombined (blossom) and then
+subdivided once, which halves every boundary segment; so the face is handed to gmsh at
+half resolution (every other side node, each side count even: quantize.py), and the
+midpoints gmsh inserts are replaced by the side nodes in between.
+
+The outline goes to gmsh in the part's canonical pose (pose.py) and starting at a vertex
+chosen from the geometry, so a turned, moved or mirrored copy of the part gets the same
+quads there too.
+"""
+
+from __future__ import annotations
+
+import gmsh
+import numpy as np
+
+from .gmsh_session import gmsh_session, silenced_stdio
+from .partition import PartitionError, _fmt
+
+KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
+
+
+def free_face_quads(outline: np.ndarray, pose) -> tuple:
+    """(interior points (P, 2), quads (Q, 4)) filling the closed polygon ``outline``
+    (2M points, counter-clockwise, not repeated at the end).  Quads index the outline's
+    points as 0 .. 2M-1 and the interior points as 2M .. 2M+P-1."""
+    fine = np.asarray(outline, dtype=float)
+    if len(fine) % 2 or len(fine) < 6:
+        raise PartitionError(f"a free face near {_fmt(fine.mean(axis=0))} has "
+                             f"{len(fine)} side segments (an even number >= 6 is needed)")
+    unit = pose.to_unit(fine)
+    if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
+        order = np.concatenate([[0], np.arange(len(fine) - 1, 0, -1)])
+    else:
+        order = np.arange(len(fine))
+    unit = unit[order]
+    start = _start(unit)
+    order = np.roll(order, -start)
+    unit = np.roll(unit, -start, axis=0)
+    if not is_simple(unit[0::2]):
+        raise PartitionError(f"a free face near {_fmt(fine.mean(axis=0))} touches or "
+                             "crosses itself: no polygon to fill")
+    interior, quads = _gmsh_fill(unit)
+    quads = np.where(quads < len(fine), order[np.minimum(quads, len(fine) - 1)], quads)
+    return pose.from_unit(interior), quads
+
+
+SIMPLE_TOL = 1e-6  # share of the polygon's size: closer than this is touching
+
+
+def is_simple(polygon: np.ndarray) -> bool:
+    """No two sides of the closed polygon cross or touch, except neighbours at their
+    shared end, and it runs counter-clockwise (gmsh may hang on anything else)."""
+    p = np.asarray(polygon, dtype=float)
+    n = len(p)
+    a, b = p, np.roll(p, -1, axis=0)
+    area = 0.5 * float(np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]))
+    tol = SIMPLE_TOL * float(np.ptp(p, axis=0).max())
+    if n < 3 or not area > tol * tol:
+        return False
+    i, j = np.triu_indices(n, 2)
+    keep = ~((i == 0) & (j == n - 1))  # the last side and the first are neighbours
+    i, j = i[keep], j[keep]
+
+    def orient(o, u, v):
+        return (u[..., 0] - o[..., 0]) * (v[..., 1] - o[..., 1]) \
+            - (u[..., 1] - o[..., 1]) * (v[..., 0] - o[..., 0])
+
+    d1, d2 = orient(a[i], b[i], a[j]), orient(a[i], b[i], b[j])
+    d3, d4 = orient(a[j], b[j], a[i]), orient(a[j], b[j], b[i])
+    if np.any((d1 * d2 < 0) & (d3 * d4 < 0)):
+        return False
+    # Touching: an end of one side within tol of the other side.
+    for ends, side in (((a[j], b[j]), i), ((a[i], b[i]), j)):
+        for q in ends:
+            u, v = a[side], b[side]
+            d = v - u
+            t = np.clip(np.sum((q - u) * d, axis=1) / np.maximum(np.sum(d * d, axis=1),
+                                                                  1e-300), 0.0, 1.0)
+            if np.any(np.hypot(*(u + t[:, None] * d - q).T) <= tol):
+                return False
+    return True
+
+
+def _start(unit: np.ndarray) -> int:
+    """An even index chosen from the geometry: the coarse point farthest from the centre
+    (ties: the larger angle key), rounded so round-off cannot move it."""
+    coarse = unit[0::2]
+    rel = coarse - coarse.mean(axis=0)
+    keys = [(round(float(np.hypot(*r)), KEY_DIGITS), round(float(np.arctan2(r[1], r[0])), 3))
+            for r in rel]
+    return 2 * max(range(len(keys)), key=lambda k: keys[k])
+
+
+def _gmsh_fill(unit: np.ndarray) -> tuple:
+    coarse = unit[0::2]
+    m = len(coarse)
+    seg = np.hypot(*(np.roll(coarse, -1, axis=0) - coarse).T)
+    sizes = 0.5 * (seg + np.roll(seg, 1))
+    with gmsh_session() as session:
+        geo = gmsh.model.geo
+        points = [geo.addPoint(float(x), float(y), 0.0, float(s))
+                  for (x, y), s in zip(coarse, sizes)]
+        lines = [geo.addLine(points[k], points[(k + 1) % m]) for k in range(m)]
+        surface = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+        geo.synchronize()
+        for line in lines:
+            gmsh.model.mesh.setTransfiniteCurve(line, 2)
+        for name, value in (("Mesh.Algorithm", 8), ("Mesh.RecombineAll", 1),
+                            ("Mesh.RecombinationAlgorithm", 1),
+                            ("Mesh.SubdivisionAlgorithm", 1), ("Mesh.MeshSizeFromPoints", 1),
+                            ("Mesh.MeshSizeFromCurvature", 0),
+                            ("Mesh.MeshSizeExtendFromBoundary", 1)):
+            session.set(name, value)
+        try:
+            with silenced_stdio():
+                gmsh.model.mesh.generate(2)
+        except Exception as exc:  # gmsh reports every failure as a bare Exception
+            raise PartitionError(f"gmsh could not fill a free face near "
+                                 f"{_fmt(coarse.mean(axis=0))}: {exc}") from None
+        index = {}
+        for k, tag in enumerate(points):
+            index[int(gmsh.model.mesh.getNodes(0, tag)[0][0])] = 2 * k
+        for k, tag in enumerate(lines):
+            inner = gmsh.model.mesh.getNodes(1, tag)[0]
+            if len(inner) != 1:
+                raise PartitionError("gmsh split a free face's side other than in two")
+            index[int(inner[0])] = 2 * k + 1
+        tags, xyz, _ = gmsh.model.mesh.getNodes(2, surface)
+        interior = xyz.reshape(-1, 3)[:, :2].copy()
+        for k, tag in enumerate(tags):
+            index[int(tag)] = 2 * m + k
+        types, _, node_tags = gmsh.model.mesh.getElements(2, surface)
+        if list(types) != [3]:
+            raise PartitionError(f"gmsh left triangles in a free face near "
+                                 f"{_fmt(coarse.mean(axis=0))}")
+        quads = np.array([index[int(t)] for t in node_tags[0]], dtype=np.int64).reshape(-1, 4)
+    return interior, quads
