@@ -17,6 +17,7 @@ itself (a zero-length edge, a walk that never closes) is a PartitionError.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -25,6 +26,15 @@ import numpy as np
 from .layout.crossings import crossings, end_places
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
+
+
+class FreeFaceError(RuntimeError):
+    """A free face could not be filled; ``origins`` name its streamline edges, which a
+    rebuild may dissolve (merging the face with its neighbours)."""
+
+    def __init__(self, message, origins):
+        super().__init__(message)
+        self.origins = frozenset(origins)
 
 
 class PartitionError(RuntimeError):
@@ -56,6 +66,7 @@ class Edge:
     b: int
     pieces: tuple = ()  # BoundaryPiece stretches, in order, for boundary edges
     streamline: int = -1  # source streamline index for interior edges
+    origin: tuple = ()  # (streamline, a, b) of the edge before any split: names it across rebuilds
 
     @property
     def is_boundary(self) -> bool:
@@ -119,8 +130,11 @@ def _boundary_key(domain, loop: int, seg: int, t: float):
     return ("b", loop, seg, round(float(t), 12))
 
 
-def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partition:
-    """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py)."""
+def build_partition(domain, streamlines, element_size: float, cuts=(),
+                    dissolve=frozenset()) -> Partition:
+    """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py),
+    less the streamline edges whose origin is in ``dissolve`` (faces merged where a free
+    face could not be filled)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -165,6 +179,9 @@ def build_partition(domain, streamlines, element_size: float, cuts=()) -> Partit
         edges.extend(_split_line(pts, splits[k], k))
     for li in range(len(domain.loops)):
         edges.extend(_boundary_edges(domain, li, sorted(boundary_splits[li]), verts))
+    edges = [dataclasses.replace(edge, origin=(edge.streamline, edge.a, edge.b))
+             for edge in edges]
+    edges = [edge for edge in edges if edge.is_boundary or edge.origin not in dissolve]
     edges = _without_dangling(_without_doubles(edges, element_size))
     while True:
         faces, free = _faces_to_blocks(np.array(verts.xy), edges, element_size)
@@ -383,8 +400,34 @@ def _faces_to_blocks(vertices, edges, h):
         try:
             blocks.append(_block_of(cycle, half, edges, vertices, h, head))
         except PartitionError as exc:
-            free.append(FreeFace(tuple(half[c] for c in cycle), str(exc)))
+            places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
+                      for c in cycle]
+            free.extend(FreeFace(lobe, str(exc))
+                        for lobe in _lobes([half[c] for c in cycle], places, h))
     return blocks, free
+
+
+SAME_PLACE = 1e-6  # vertices closer than this (element sizes) are one place of a face
+
+
+def _lobes(halves, places, h) -> list:
+    """A face's walk split where it passes one place twice (a pinch) into simple loops:
+    each is a polygon of its own, where the whole walk is none."""
+    tol = SAME_PLACE * h
+    place_id = []
+    for k, p in enumerate(places):
+        same = [place_id[j] for j in range(k) if np.hypot(*(places[j] - p)) <= tol]
+        place_id.append(same[0] if same else k)
+    lobes, stack = [], []  # stack: (place, half) of the walk not yet in a lobe
+    for place, h_e in zip(place_id, halves):
+        at = next((i for i, (q, _) in enumerate(stack) if q == place), None)
+        if at is not None:
+            lobes.append(tuple(x for _, x in stack[at:]))
+            del stack[at:]
+        stack.append((place, h_e))
+    if stack:
+        lobes.append(tuple(x for _, x in stack))
+    return lobes
 
 
 def _block_of(cycle, half, edges, vertices, h, head):

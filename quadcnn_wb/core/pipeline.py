@@ -17,8 +17,8 @@ from .cuts import connecting_cuts
 from .domain import Domain
 from .gmsh_quads import gmsh_quad_mesh
 from .layout.motorcycle import stop_at_first_hits
-from .layout.quantize import quantize
-from .partition import FreeFace, Partition, PartitionError, build_partition
+from .layout.quantize import quantize, quantize_freeing
+from .partition import FreeFace, FreeFaceError, Partition, PartitionError, build_partition
 from .pose import diameter
 from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality, structured_share
@@ -155,34 +155,50 @@ def _t_mesh(domain, background, lines) -> tuple:
     return stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
 
 
-FREEING_ROUNDS = 3  # blocks whose map folds are handed to the free-face mesher this often
+FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable free face
 
 
 def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
                      allow_free=True):
     """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
     can be had from these streamlines.  Faces that are no blocks, and blocks whose map
-    gives a degenerate element, get unstructured quads (free faces) unless ``allow_free``
-    is False (the cnn path: its lines are then not trusted)."""
-    clock = time.perf_counter()
-    cuts, partition = _partition(domain, background, field, lines)
-    timings["partition"] = time.perf_counter() - clock
-    if partition.free_faces and not allow_free:
-        raise PartitionError(partition.free_faces[0].reason)
-    timings["quantization"] = timings["quad_mesh"] = 0.0
+    gives a degenerate element, get unstructured quads (free faces); a free face that
+    cannot be filled (it pinches or touches itself) loses its streamline edges, merging
+    it with its neighbours, and the partition is built again.  Not when ``allow_free`` is
+    False (the cnn path: its lines are then not trusted)."""
+    timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
+    dissolve, freed = frozenset(), set()
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
-        counts = quantize(partition, size)
+        cuts, partition = _partition(domain, background, field, lines, dissolve)
+        partition = free_blocks(partition, [k for k in range(len(partition.blocks))
+                                            if _block_key(partition, k) in freed],
+                                "a block map gives a degenerate element")
+        timings["partition"] += time.perf_counter() - clock
+        if partition.free_faces and not allow_free:
+            raise PartitionError(partition.free_faces[0].reason)
+        clock = time.perf_counter()
+        counts, unequal = quantize_freeing(partition, size) if allow_free \
+            else (quantize(partition, size), [])
+        partition = free_blocks(partition, unequal, "no segment counts make its opposite "
+                                                    "sides equal")
         timings["quantization"] += time.perf_counter() - clock
         clock = time.perf_counter()
-        mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
+        try:
+            mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
+        except FreeFaceError as exc:
+            timings["quad_mesh"] += time.perf_counter() - clock
+            if not exc.origins or round_ == FREEING_ROUNDS:
+                raise PartitionError(str(exc)) from None
+            dissolve = dissolve | exc.origins
+            continue
         timings["quad_mesh"] += time.perf_counter() - clock
         sj = scaled_jacobians(mesh.nodes, mesh.quads)
-        folded = sorted({int(b) for b in mesh.block_of_quad[sj <= MIN_VALID_JACOBIAN]
-                         if b >= 0})
+        folded = {_block_key(partition, int(b))
+                  for b in mesh.block_of_quad[sj <= MIN_VALID_JACOBIAN] if b >= 0}
         if not folded or not allow_free or round_ == FREEING_ROUNDS:
             break
-        partition = free_blocks(partition, folded)
+        freed |= folded
     worst = sj.min() if len(sj) else 0.0
     if worst <= MIN_VALID_JACOBIAN:
         raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
@@ -194,12 +210,20 @@ def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     return cuts, partition, counts, mesh
 
 
-def free_blocks(partition: Partition, blocks) -> Partition:
-    """The partition with these blocks turned into free faces."""
-    chosen = set(blocks)
+def _block_key(partition: Partition, b: int) -> frozenset:
+    """A block named by its corner places, which a rebuild keeps."""
+    return frozenset(tuple(np.round(partition.vertices[c], 12)) for c in
+                     partition.blocks[b].corners)
+
+
+def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
+    """The partition with these blocks (indices) turned into free faces."""
+    chosen = set(chosen)
+    if not chosen:
+        return partition
     kept = [b for k, b in enumerate(partition.blocks) if k not in chosen]
-    freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side),
-                      "a block map gives a degenerate element") for k in sorted(chosen)]
+    freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side), reason)
+             for k in sorted(chosen)]
     return dataclasses.replace(partition, blocks=kept,
                                free_faces=list(partition.free_faces) + freed)
 
@@ -241,6 +265,6 @@ def tiles_exactly(nodes, quads) -> bool:
     return bool(abs(area - enclosed) <= 1e-9 * max(abs(enclosed), 1e-300))
 
 
-def _partition(domain, background, field, lines):
+def _partition(domain, background, field, lines, dissolve=frozenset()):
     cuts = connecting_cuts(domain, background, field, lines)
-    return cuts, build_partition(domain, lines, background.element_size, cuts)
+    return cuts, build_partition(domain, lines, background.element_size, cuts, dissolve)

@@ -18,7 +18,7 @@ import numpy as np
 
 from .free_faces import free_face_quads
 from .layout.collapse import conflicts, merges, node_layout, side_nodes
-from .partition import Partition, PartitionError
+from .partition import FreeFaceError, Partition, PartitionError
 from .pose import canonical_pose
 
 SMOOTH_ITERATIONS = 40
@@ -114,7 +114,11 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     if partition.free_faces:
         pose = canonical_pose(domain)
         for face in partition.free_faces:
-            q = _free_face(layout, ids, positions, face, pose)
+            try:
+                q = _free_face(layout, ids, positions, face, pose)
+            except PartitionError as exc:
+                raise FreeFaceError(str(exc), [partition.edges[e].origin for e, _ in face.halves
+                                               if not partition.edges[e].is_boundary]) from None
             quads.append(q)
             owner.append(np.full(len(q), -1))
     nodes = np.array(positions, dtype=float)
@@ -144,6 +148,10 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     if len(np.unique(ring)) != len(ring):
         raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
     interior, local = free_face_quads(np.array(positions)[ring], pose)
+    corners = np.vstack([np.array(positions)[ring], interior])[local]
+    if _sj_batch(corners).min() <= 0 and _sj_batch(corners[:, ::-1]).min() <= 0:
+        raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
+                             "curved sides")
     first = len(positions)
     positions.extend(interior)
     return np.where(local < len(ring), ring[np.minimum(local, len(ring) - 1)],

@@ -132,9 +132,9 @@ def _split_edge(vertices, edges, e, s, domain):
     before = pts[cum < s]
     after = pts[cum > s]
     edges[e] = Edge(points=np.vstack([before, point]), a=edge.a, b=v, pieces=first,
-                    streamline=edge.streamline)
+                    streamline=edge.streamline, origin=edge.origin)
     edges.append(Edge(points=np.vstack([point, after]), a=v, b=edge.b, pieces=second,
-                      streamline=edge.streamline))
+                      streamline=edge.streamline, origin=edge.origin))
     return v, len(edges) - 1
 
 

@@ -26,6 +26,9 @@ the upper envelope of its secants through consecutive integers, exact at every i
 
 from __future__ import annotations
 
+import dataclasses
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.optimize import Bounds, LinearConstraint, milp
 from scipy.sparse import coo_matrix, lil_matrix
@@ -85,70 +88,117 @@ def _rows(entries: list, n_columns: int):
 
 MAX_ROUNDS = 30  # conflict rows added one solve at a time
 MIN_FREE_FACE_HALVES = 3  # a free face's outline at half resolution: at least a triangle
+FREE_BLOCK_COST = 1000.0  # a block given up to unstructured quads, in squared segments
+
+
+@dataclass
+class _Problem:
+    """The integer program's pieces: columns are n (E), c (E), m (E), z (B)."""
+
+    n_edges: int
+    n_blocks: int
+    rows: list  # (coefficients {column: value}, lower, upper)
+
+    @property
+    def n_columns(self) -> int:
+        return 3 * self.n_edges + self.n_blocks
+
+    def constraint(self, extra=()):
+        rows = list(self.rows) + list(extra)
+        return LinearConstraint(_rows([r for r, _, _ in rows], self.n_columns),
+                                [lo for _, lo, _ in rows], [up for _, _, up in rows])
 
 
 def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.ndarray:
-    """Integer segment count per edge of the partition (0 allowed on streamline arcs).
+    """Integer segment count per edge of the partition, every block kept (PartitionError
+    when no counts make all blocks' opposite sides equal)."""
+    counts, freed = _solve(partition, size, time_limit, free_blocks=False)
+    return counts
+
+
+def quantize_freeing(partition: Partition, size: float, time_limit: float = 20.0) -> tuple:
+    """(counts, blocks given up): every block kept where that is feasible (the usual
+    case, and the faster program), else as few given up as the traces force."""
+    try:
+        return _solve(partition, size, time_limit, free_blocks=False)
+    except PartitionError as exc:
+        if "infeasible" not in str(exc):
+            raise
+    return _solve(partition, size, time_limit, free_blocks=True)
+
+
+def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bool) -> tuple:
+    """(counts per edge, indices of blocks given up to free faces).
 
     Edges of free faces get an even count of at least 2 (n_e = 2 m_e): their quads come
-    from a mesh of the face at half resolution, subdivided (free_faces.py).  Evenness
-    keeps the program feasible: the block equalities are homogeneous, so twice any
-    solution is a solution, and a free face is constrained by nothing else.
+    from a mesh of the face at half resolution, subdivided (free_faces.py).  A block may be
+    given up (z_b = 1, at FREE_BLOCK_COST): its equalities are lifted and its edges become
+    free-face edges.  That keeps the program feasible by construction: with every block
+    given up, each edge takes 2 or more even segments and nothing else constrains it.  The
+    solver gives up as few blocks as the traces force (numerical traces satisfy the
+    equalities only approximately; chains of T-junctions can contradict each other).
     """
-    n_edges = len(partition.edges)
+    n_edges, n_blocks = len(partition.edges), len(partition.blocks)
     if n_edges == 0:
-        return np.zeros(0, dtype=int)
+        return np.zeros(0, dtype=int), []
     order = geometric_order(partition, size)
     position = np.empty(n_edges, dtype=np.int64)
     position[order] = np.arange(n_edges)  # edge e is variable position[e]
-    free_edges = sorted({int(position[e]) for face in partition.free_faces
-                         for e, _ in face.halves})
-    half_of = {v: 2 * n_edges + k for k, v in enumerate(free_edges)}  # m_e's column
-    n_columns = 2 * n_edges + len(free_edges)
+    block_order = sorted(range(n_blocks), key=lambda b: sorted(
+        int(position[e]) for side in partition.blocks[b].sides for e, _ in side))
+    z_col = {b: 3 * n_edges + k for k, b in enumerate(block_order)}
     # Rounded: a turned or rescaled copy must pose the very same problem (near-ties at
     # n + 0.5 would otherwise be broken by rounding noise).
     target = np.round(np.array([partition.edges[e].length / size for e in order]), 9)
     lower = np.array([1 if partition.edges[e].is_boundary else 0 for e in order])
+    free_edges = sorted({int(position[e]) for face in partition.free_faces
+                         for e, _ in face.halves})
     lower[free_edges] = 2
-    equalities = []  # (variable positions with +1, with -1), in a geometric order too
-    for block in partition.blocks:
-        for pair in (0, 1):
-            plus = sorted(int(position[e]) for e, _ in block.sides[pair])
-            minus = sorted(int(position[e]) for e, _ in block.sides[pair + 2])
-            equalities.append((plus, minus) if plus < minus else (minus, plus))
-    equalities.sort()
-    rows = []
-    for plus, minus in equalities:
-        row: dict = {}
-        for v in plus:
-            row[v] = row.get(v, 0) + 1
-        for v in minus:
-            row[v] = row.get(v, 0) - 1
-        rows.append(row)
-    rows.extend({v: 1, half_of[v]: -2} for v in free_edges)
     upper = np.maximum(4 * np.ceil(target) + 4, 8).astype(int)
-    constraints = [_secant_rows(target, lower, upper, n_columns)]
-    if rows:
-        constraints.append(LinearConstraint(_rows(rows, n_columns), 0, 0))
-    if partition.free_faces:
-        at_least = [{half_of[int(position[e])]: 1 for e, _ in face.halves}
-                    for face in partition.free_faces]
-        constraints.append(LinearConstraint(_rows(at_least, n_columns),
-                                            MIN_FREE_FACE_HALVES, np.inf))
-    cost = np.concatenate([np.zeros(n_edges), np.ones(n_edges), np.zeros(len(free_edges))])
-    integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges),
-                                  np.ones(len(free_edges))])
-    bounds = Bounds(np.concatenate([lower, np.zeros(n_edges), np.ones(len(free_edges))]),
-                    np.concatenate([upper, np.full(n_edges, np.inf),
-                                    np.full(len(free_edges), np.inf)]))
+    big = float(upper.max()) * (n_edges + 1)
+    rows = []
+    rows.extend(({v: 1, 2 * n_edges + v: -2}, 0, 0) for v in free_edges)
+    for face in partition.free_faces:
+        rows.append(({2 * n_edges + int(position[e]): 1 for e, _ in face.halves},
+                     MIN_FREE_FACE_HALVES, np.inf))
+    for b in block_order:
+        block = partition.blocks[b]
+        z = z_col[b]
+        for pair in (0, 1):
+            row: dict = {}
+            for e, _ in block.sides[pair]:
+                row[int(position[e])] = row.get(int(position[e]), 0) + 1
+            for e, _ in block.sides[pair + 2]:
+                row[int(position[e])] = row.get(int(position[e]), 0) - 1
+            # |plus - minus| <= big z_b
+            rows.append(({**row, z: -big}, -np.inf, 0))
+            rows.append(({**row, z: big}, 0, np.inf))
+        variables = sorted({int(position[e]) for side in block.sides for e, _ in side})
+        for v in variables:
+            if v in free_edges:
+                continue
+            # given up: n_v even (|n_v - 2 m_v| <= big (1 - z_b)) and at least 2
+            rows.append(({v: 1, 2 * n_edges + v: -2, z: big}, -np.inf, big))
+            rows.append(({v: 1, 2 * n_edges + v: -2, z: -big}, -big, np.inf))
+            rows.append(({v: 1, z: -(2 - lower[v])}, lower[v], np.inf))
+        rows.append(({**{2 * n_edges + v: 1 for v in variables}, z: -MIN_FREE_FACE_HALVES},
+                     0, np.inf))
+    problem = _Problem(n_edges, n_blocks, rows)
+    secants = _secant_rows(target, lower, upper, problem.n_columns)
+    cost = np.concatenate([np.zeros(n_edges), np.ones(n_edges), np.zeros(n_edges),
+                           np.full(n_blocks, FREE_BLOCK_COST)])
+    integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges), np.ones(n_edges),
+                                  np.ones(n_blocks)])
+    z_upper = 1 if free_blocks else 0
+    bounds = Bounds(np.concatenate([lower, np.zeros(2 * n_edges), np.zeros(n_blocks)]),
+                    np.concatenate([upper, np.full(n_edges, np.inf), upper,
+                                    np.full(n_blocks, z_upper)]))
     forbidden = []  # rows: at least one segment among these variables
     for _ in range(MAX_ROUNDS):
-        extra = []
-        if forbidden:
-            extra = [LinearConstraint(_rows([dict.fromkeys(f, 1) for f in forbidden],
-                                            n_columns), 1, np.inf)]
-        result = milp(cost, constraints=constraints + extra, integrality=integrality,
-                      bounds=bounds, options={"time_limit": time_limit})
+        extra = [(dict.fromkeys(f, 1), 1, np.inf) for f in forbidden]
+        result = milp(cost, constraints=[secants, problem.constraint(extra)],
+                      integrality=integrality, bounds=bounds,
+                      options={"time_limit": time_limit})
         if result.x is None:
             raise PartitionError(f"no segment counts make opposite block sides equal "
                                  f"({result.message})")
@@ -156,10 +206,13 @@ def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.
             raise PartitionError(f"the segment-count program found no proven optimum "
                                  f"within {time_limit:g} s ({result.message})")
         counts = np.rint(result.x[:n_edges]).astype(int)[position]
-        layout = node_layout(partition, counts)
-        found = conflicts(layout, merges(partition, layout, counts))
+        freed = sorted(b for b in range(n_blocks) if result.x[z_col[b]] > 0.5)
+        kept = [b for b in range(n_blocks) if b not in set(freed)]
+        reduced = dataclasses.replace(partition, blocks=[partition.blocks[b] for b in kept])
+        layout = node_layout(reduced, counts)
+        found = conflicts(layout, merges(reduced, layout, counts))
         if not found:
-            return counts
+            return counts, freed
         for reasons in found:
             variables = set()
             for reason in reasons:
@@ -168,7 +221,7 @@ def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.
                 else:
                     _, b, pair = reason
                     variables.update(int(position[e]) for e, _ in
-                                     partition.blocks[b].sides[pair])
+                                     reduced.blocks[b].sides[pair])
             forbidden.append(sorted(variables))
     raise PartitionError("the segment counts keep pinching the domain (merging boundary "
                          "nodes or singular points)")
