@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import json
+import re
 
 import meshio
 import numpy as np
@@ -133,14 +134,27 @@ def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
         assert result.stderr.startswith("error:") and message in result.stderr
 
 
-def test_a_partition_that_is_not_four_sided_is_refused():
-    from quadcnn_wb.core.partition import PartitionError, build_partition
+def test_faces_that_are_not_blocks_get_conforming_unstructured_quads():
+    from quadcnn_wb.core.partition import build_partition
+    from quadcnn_wb.core.pipeline import blocks_and_mesh, free_edges_on_boundary, tiles_exactly
 
     result = meshed("plate_hole")
     lines = list(result.reference.streamlines)
     incomplete = [line for line in lines if line.end.kind != "singularity"][1:]
-    with pytest.raises(PartitionError, match="corners instead of 4|turns back"):
-        build_partition(result.domain, incomplete, result.reference.mesh.element_size)
+    ref = result.reference
+    partition = build_partition(result.domain, incomplete, ref.mesh.element_size)
+    assert partition.free_faces
+    assert all(re.search("corners instead of 4|turns back|too concave", face.reason)
+               for face in partition.free_faces)
+    _, partition, counts, mesh = blocks_and_mesh(result.domain, ref.mesh, ref.field,
+                                                  incomplete, result.size, True, {})
+    free = mesh.block_of_quad < 0
+    assert free.any() and not free.all()  # only the free faces lost their blocks
+    assert tiles_exactly(mesh.nodes, mesh.quads)
+    assert free_edges_on_boundary(mesh.quads, mesh.boundary)
+    check_quad_mesh(mesh.nodes, mesh.quads, result.domain.area, on_boundary_of(result.domain))
+    edges = [e for face in partition.free_faces for e, _ in face.halves]
+    assert all(counts[e] >= 2 and counts[e] % 2 == 0 for e in edges)
 
 
 def test_the_hexagons_near_coincident_singular_points_get_blocks():

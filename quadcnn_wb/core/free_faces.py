@@ -24,28 +24,34 @@ from .partition import PartitionError, _fmt
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 
 
-def free_face_quads(outline: np.ndarray, pose) -> tuple:
-    """(interior points (P, 2), quads (Q, 4)) filling the closed polygon ``outline``
-    (2M points, counter-clockwise, not repeated at the end).  Quads index the outline's
-    points as 0 .. 2M-1 and the interior points as 2M .. 2M+P-1."""
-    fine = np.asarray(outline, dtype=float)
-    if len(fine) % 2 or len(fine) < 6:
-        raise PartitionError(f"a free face near {_fmt(fine.mean(axis=0))} has "
-                             f"{len(fine)} side segments (an even number >= 6 is needed)")
-    unit = pose.to_unit(fine)
-    if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
-        order = np.concatenate([[0], np.arange(len(fine) - 1, 0, -1)])
-    else:
-        order = np.arange(len(fine))
-    unit = unit[order]
-    start = _start(unit)
-    order = np.roll(order, -start)
-    unit = np.roll(unit, -start, axis=0)
-    if not is_simple(unit[0::2]):
-        raise PartitionError(f"a free face near {_fmt(fine.mean(axis=0))} touches or "
-                             "crosses itself: no polygon to fill")
-    interior, quads = _gmsh_fill(unit)
-    quads = np.where(quads < len(fine), order[np.minimum(quads, len(fine) - 1)], quads)
+def free_face_quads(rings, pose) -> tuple:
+    """(interior points (P, 2), quads (Q, 4)) filling the region bounded by ``rings``:
+    the outer polygon (counter-clockwise) and the holes in it (clockwise), each of an
+    even number of points, not repeated at the end.  Quads index the rings' points in
+    order (outer first) as 0 .. N-1 and the interior points as N .. N+P-1."""
+    rings = [np.asarray(r, dtype=float) for r in rings]
+    centre = rings[0].mean(axis=0)
+    if any(len(r) % 2 for r in rings) or len(rings[0]) < 6:
+        raise PartitionError(f"a free face near {_fmt(centre)} has {len(rings[0])} side "
+                             "segments (an even number >= 6 is needed)")
+    units, orders, offset = [], [], 0
+    for k, ring in enumerate(rings):
+        unit = pose.to_unit(ring)
+        order = np.arange(len(ring))
+        if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
+            order = np.concatenate([[0], np.arange(len(ring) - 1, 0, -1)])
+        start = _start(unit[order])
+        order = np.roll(order, -start)
+        unit = unit[order]
+        if not is_simple(unit[0::2] if k == 0 else unit[0::2][::-1]):
+            raise PartitionError(f"a free face near {_fmt(centre)} touches or crosses "
+                                 "itself: no polygon to fill")
+        units.append(unit)
+        orders.append(order + offset)
+        offset += len(ring)
+    interior, quads = _gmsh_fill(units)
+    order = np.concatenate(orders)
+    quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
     return pose.from_unit(interior), quads
 
 
@@ -96,19 +102,26 @@ def _start(unit: np.ndarray) -> int:
     return 2 * max(range(len(keys)), key=lambda k: keys[k])
 
 
-def _gmsh_fill(unit: np.ndarray) -> tuple:
-    coarse = unit[0::2]
-    m = len(coarse)
-    seg = np.hypot(*(np.roll(coarse, -1, axis=0) - coarse).T)
-    sizes = 0.5 * (seg + np.roll(seg, 1))
+def _gmsh_fill(units) -> tuple:
+    """gmsh's quads for the rings at half resolution; local ids as free_face_quads."""
     with gmsh_session() as session:
         geo = gmsh.model.geo
-        points = [geo.addPoint(float(x), float(y), 0.0, float(s))
-                  for (x, y), s in zip(coarse, sizes)]
-        lines = [geo.addLine(points[k], points[(k + 1) % m]) for k in range(m)]
-        surface = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+        loops, point_of, line_of, offset = [], {}, {}, 0
+        for unit in units:
+            coarse = unit[0::2]
+            m = len(coarse)
+            seg = np.hypot(*(np.roll(coarse, -1, axis=0) - coarse).T)
+            sizes = 0.5 * (seg + np.roll(seg, 1))
+            points = [geo.addPoint(float(x), float(y), 0.0, float(s))
+                      for (x, y), s in zip(coarse, sizes)]
+            lines = [geo.addLine(points[k], points[(k + 1) % m]) for k in range(m)]
+            loops.append(geo.addCurveLoop(lines))
+            point_of.update({tag: offset + 2 * k for k, tag in enumerate(points)})
+            line_of.update({tag: offset + 2 * k + 1 for k, tag in enumerate(lines)})
+            offset += len(unit)
+        surface = geo.addPlaneSurface(loops)
         geo.synchronize()
-        for line in lines:
+        for line in line_of:
             gmsh.model.mesh.setTransfiniteCurve(line, 2)
         for name, value in (("Mesh.Algorithm", 8), ("Mesh.RecombineAll", 1),
                             ("Mesh.RecombinationAlgorithm", 1),
@@ -116,27 +129,27 @@ def _gmsh_fill(unit: np.ndarray) -> tuple:
                             ("Mesh.MeshSizeFromCurvature", 0),
                             ("Mesh.MeshSizeExtendFromBoundary", 1)):
             session.set(name, value)
+        centre = units[0].mean(axis=0)
         try:
             with silenced_stdio():
                 gmsh.model.mesh.generate(2)
         except Exception as exc:  # gmsh reports every failure as a bare Exception
-            raise PartitionError(f"gmsh could not fill a free face near "
-                                 f"{_fmt(coarse.mean(axis=0))}: {exc}") from None
+            raise PartitionError(f"gmsh could not fill a free face near {_fmt(centre)}: "
+                                 f"{exc}") from None
         index = {}
-        for k, tag in enumerate(points):
-            index[int(gmsh.model.mesh.getNodes(0, tag)[0][0])] = 2 * k
-        for k, tag in enumerate(lines):
+        for tag, local in point_of.items():
+            index[int(gmsh.model.mesh.getNodes(0, tag)[0][0])] = local
+        for tag, local in line_of.items():
             inner = gmsh.model.mesh.getNodes(1, tag)[0]
             if len(inner) != 1:
                 raise PartitionError("gmsh split a free face's side other than in two")
-            index[int(inner[0])] = 2 * k + 1
+            index[int(inner[0])] = local
         tags, xyz, _ = gmsh.model.mesh.getNodes(2, surface)
         interior = xyz.reshape(-1, 3)[:, :2].copy()
         for k, tag in enumerate(tags):
-            index[int(tag)] = 2 * m + k
+            index[int(tag)] = offset + k
         types, _, node_tags = gmsh.model.mesh.getElements(2, surface)
         if list(types) != [3]:
-            raise PartitionError(f"gmsh left triangles in a free face near "
-                                 f"{_fmt(coarse.mean(axis=0))}")
+            raise PartitionError(f"gmsh left triangles in a free face near {_fmt(centre)}")
         quads = np.array([index[int(t)] for t in node_tags[0]], dtype=np.int64).reshape(-1, 4)
     return interior, quads

@@ -89,6 +89,11 @@ class FreeFace:
 
     halves: tuple  # (edge id, forward) around the face, the face on the left
     reason: str
+    holes: tuple = ()  # rings of (edge id, forward) of the loops inside it
+
+    @property
+    def rings(self) -> tuple:
+        return (self.halves,) + tuple(self.holes)
 
 
 @dataclass
@@ -184,17 +189,37 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = [edge for edge in edges if edge.is_boundary or edge.origin not in dissolve]
     edges = _without_dangling(_without_doubles(edges, element_size))
     while True:
-        faces, free = _faces_to_blocks(np.array(verts.xy), edges, element_size)
-        slits = _slits(free, edges)
+        faces, free, islands = _faces_to_blocks(np.array(verts.xy), edges, element_size)
+        slits = _slits(free, edges) | {e for island in islands for e, _ in island
+                                       if not edges[e].is_boundary}
         if not slits:
             break
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
     from .subdivide import split_odd_faces
 
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
+    blocks, free = _with_holes(blocks, free, islands, edges)
     singular = tuple(sorted(v for key, v in verts.by_key.items() if key[0] == "s"))
-    return Partition(vertices=np.array(vertices), edges=edges, blocks=blocks, cuts=list(cuts),
-                     singular=singular, free_faces=free)
+    return _used_vertices_only(Partition(vertices=np.array(vertices), edges=edges,
+                                         blocks=blocks, cuts=list(cuts), singular=singular,
+                                         free_faces=free))
+
+
+def _used_vertices_only(partition: Partition) -> Partition:
+    """The partition without the vertices that no edge uses any more (a dropped edge's
+    ends), renumbered in order: every vertex becomes a mesh node, and unused nodes are
+    no mesh.  (Edge origins keep the first numbering: they name edges across rebuilds.)"""
+    used = sorted({v for edge in partition.edges for v in (edge.a, edge.b)})
+    if len(used) == len(partition.vertices):
+        return partition
+    new = {v: k for k, v in enumerate(used)}
+    edges = [dataclasses.replace(edge, a=new[edge.a], b=new[edge.b])
+             for edge in partition.edges]
+    blocks = [dataclasses.replace(block, corners=tuple(new[c] for c in block.corners))
+              for block in partition.blocks]
+    return dataclasses.replace(partition, vertices=partition.vertices[used], edges=edges,
+                               blocks=blocks,
+                               singular=tuple(new[v] for v in partition.singular if v in new))
 
 
 DOUBLE_EDGE_GAP = 0.5  # two edges of the same ends closer than this (element sizes) are one
@@ -249,9 +274,58 @@ def _without_dangling(edges) -> list:
         edges = keep
 
 
+def _with_holes(blocks, free, islands, edges) -> tuple:
+    """(blocks, free faces) with each remaining island (a hole loop no streamline reaches
+    any more) a hole of the smallest face around it; a block around one is no block."""
+    if not islands:
+        return blocks, free
+    faces = [("block", b, tuple(h for side in block.sides for h in side))
+             for b, block in enumerate(blocks)]
+    faces += [("free", f, face.halves) for f, face in enumerate(free)]
+    outlines = [_outline(edges, halves) for _, _, halves in faces]
+    holes: dict = {}
+    for island in islands:
+        probe = _outline(edges, island)[0]
+        around = [k for k, o in enumerate(outlines) if _inside_polygon(o, probe)]
+        if not around:
+            raise PartitionError(f"a loop near {_fmt(probe)} lies in no face")
+        k = min(around, key=lambda k: abs(_polygon_area(outlines[k])))
+        holes.setdefault(k, []).append(island)
+    out_blocks, out_free = [], []
+    for k, (kind, index, halves) in enumerate(faces):
+        if k not in holes:
+            (out_blocks if kind == "block" else out_free).append(
+                blocks[index] if kind == "block" else free[index])
+            continue
+        reason = free[index].reason if kind == "free" else "a block with a hole in it"
+        out_free.append(FreeFace(halves, reason, tuple(holes[k])))
+    return out_blocks, out_free
+
+
+def _outline(edges, halves) -> np.ndarray:
+    return np.vstack([edges[e].points if forward else edges[e].points[::-1]
+                      for e, forward in halves])
+
+
+def _polygon_area(pts) -> float:
+    return 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1)
+                              - np.roll(pts[:, 0], -1) * pts[:, 1]))
+
+
+def _inside_polygon(polygon, p) -> bool:
+    x, y = p
+    inside = False
+    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
+
+
 def _slits(free, edges) -> set:
     """Streamline edges with a free face on both sides: they separate nothing, and a face
-    with a slit is no polygon to fill; without them the face is one."""
+    with a slit is no polygon to fill; without them the face is one.  (So do the edges
+    around an island, a group of streamline edges that touches nothing else: they are
+    dissolved into the face around them.)"""
     out = set()
     for face in free:
         seen = set()
@@ -383,7 +457,7 @@ def _faces_to_blocks(vertices, edges, h):
         return items[(k - 1) % len(items)][1]
 
     seen = set()
-    blocks, free = [], []
+    blocks, free, islands = [], [], []
     for start in range(len(half)):
         if start in seen:
             continue
@@ -397,14 +471,24 @@ def _faces_to_blocks(vertices, edges, h):
                 raise PartitionError("the arrangement of streamlines is not planar")
         if any(edges[half[c][0]].is_boundary and not half[c][1] for c in cycle):
             continue  # outside the domain (the outer face, or inside a hole)
+        if _signed_area(edges, [half[c] for c in cycle]) <= 0:
+            islands.append(tuple(half[c] for c in cycle))  # the outside of an island
+            continue
         try:
             blocks.append(_block_of(cycle, half, edges, vertices, h, head))
         except PartitionError as exc:
             places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
                       for c in cycle]
-            free.extend(FreeFace(lobe, str(exc))
-                        for lobe in _lobes([half[c] for c in cycle], places, h))
-    return blocks, free
+            for lobe in _lobes([half[c] for c in cycle], places, h):
+                if _signed_area(edges, lobe) > 0:
+                    free.append(FreeFace(lobe, str(exc)))
+                else:
+                    islands.append(lobe)
+    return blocks, free, islands
+
+
+def _signed_area(edges, halves) -> float:
+    return _polygon_area(_outline(edges, halves))
 
 
 SAME_PLACE = 1e-6  # vertices closer than this (element sizes) are one place of a face

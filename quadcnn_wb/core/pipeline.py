@@ -115,7 +115,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     problem = ""
     try:
         try:
-            cuts, partition, counts, mesh = _blocks_and_mesh(
+            cuts, partition, counts, mesh = blocks_and_mesh(
                 domain, background, field, lines, size, smoothing, timings,
                 allow_free=method != "cnn")
         except PartitionError:
@@ -127,7 +127,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
                           for line in trace_streamlines(domain, background, field))
             lines = _t_mesh(domain, background, lines)
             timings["fallback_tracing"] = time.perf_counter() - clock
-            cuts, partition, counts, mesh = _blocks_and_mesh(domain, background, field, lines,
+            cuts, partition, counts, mesh = blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
     except PartitionError as exc:
         # Never leave a valid input without a mesh, nor with one worse than gmsh's own:
@@ -158,7 +158,7 @@ def _t_mesh(domain, background, lines) -> tuple:
 FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable free face
 
 
-def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
+def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
                      allow_free=True):
     """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
     can be had from these streamlines.  Faces that are no blocks, and blocks whose map
@@ -207,6 +207,8 @@ def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         raise PartitionError("the blocks overlap (their quads fold over each other)")
     if not free_edges_on_boundary(mesh.quads, mesh.boundary):
         raise PartitionError("the blocks leave a gap inside the domain")
+    if not boundary_on_free_edges(mesh.quads, mesh.boundary):
+        raise PartitionError("the quads cover a hole")
     return cuts, partition, counts, mesh
 
 
@@ -246,6 +248,19 @@ def free_edges_on_boundary(quads, boundary) -> bool:
     _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     free = key[counts[inverse.ravel()] == 1]
     return bool(boundary[free].all())
+
+
+def boundary_on_free_edges(quads, boundary) -> bool:
+    """Every used boundary node is an end of an edge used by one quad only: no boundary
+    loop lies inside the mesh (a hole filled over)."""
+    directed = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    key = np.sort(directed, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    on_free = np.zeros(len(boundary), dtype=bool)
+    on_free[key[counts[inverse.ravel()] == 1].ravel()] = True
+    used = np.zeros(len(boundary), dtype=bool)
+    used[quads.ravel()] = True
+    return bool(np.all(on_free[boundary & used]))
 
 
 def tiles_exactly(nodes, quads) -> bool:

@@ -117,7 +117,8 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
             try:
                 q = _free_face(layout, ids, positions, face, pose)
             except PartitionError as exc:
-                raise FreeFaceError(str(exc), [partition.edges[e].origin for e, _ in face.halves
+                raise FreeFaceError(str(exc), [partition.edges[e].origin
+                                               for ring in face.rings for e, _ in ring
                                                if not partition.edges[e].is_boundary]) from None
             quads.append(q)
             owner.append(np.full(len(q), -1))
@@ -140,22 +141,26 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
 
 def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     """Quads of one free face (global node ids); its interior points join positions."""
-    ring = []
-    for e, forward in face.halves:
-        part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
-        ring.extend(int(i) for i in ids[part[:-1]])
-    ring = np.array(ring, dtype=np.int64)
-    if len(np.unique(ring)) != len(ring):
+    rings = []
+    for ring_halves in face.rings:
+        ring = []
+        for e, forward in ring_halves:
+            part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
+            ring.extend(int(i) for i in ids[part[:-1]])
+        rings.append(np.array(ring, dtype=np.int64))
+    every = np.concatenate(rings)
+    if len(np.unique(every)) != len(every):
         raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
-    interior, local = free_face_quads(np.array(positions)[ring], pose)
-    corners = np.vstack([np.array(positions)[ring], interior])[local]
+    xy = np.array(positions)
+    interior, local = free_face_quads([xy[r] for r in rings], pose)
+    corners = np.vstack([xy[every], interior])[local]
     if _sj_batch(corners).min() <= 0 and _sj_batch(corners[:, ::-1]).min() <= 0:
         raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
                              "curved sides")
     first = len(positions)
     positions.extend(interior)
-    return np.where(local < len(ring), ring[np.minimum(local, len(ring) - 1)],
-                    local - len(ring) + first)
+    return np.where(local < len(every), every[np.minimum(local, len(every) - 1)],
+                    local - len(every) + first)
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt
+from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt, _inside_polygon
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
@@ -151,12 +151,3 @@ def _split_pieces(pieces, s, domain):
             return first, second, curve.point(t)
         remaining -= length
     raise PartitionError("could not split a boundary edge")
-
-
-def _inside_polygon(polygon, p) -> bool:
-    x, y = p
-    inside = False
-    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside

@@ -152,7 +152,7 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
     target = np.round(np.array([partition.edges[e].length / size for e in order]), 9)
     lower = np.array([1 if partition.edges[e].is_boundary else 0 for e in order])
     free_edges = sorted({int(position[e]) for face in partition.free_faces
-                         for e, _ in face.halves})
+                         for ring in face.rings for e, _ in ring})
     lower[free_edges] = 2
     upper = np.maximum(4 * np.ceil(target) + 4, 8).astype(int)
     big = float(upper.max()) * (n_edges + 1)
