@@ -102,6 +102,16 @@ def _start(unit: np.ndarray) -> int:
     return 2 * max(range(len(keys)), key=lambda k: keys[k])
 
 
+BEND_TOL = 1e-3  # a side node this far off its chord (share of the chord) bends the side
+
+
+def _bends(a, middle, b) -> bool:
+    chord = b - a
+    length = float(np.hypot(*chord))
+    off = abs(float(chord[0] * (middle[1] - a[1]) - chord[1] * (middle[0] - a[0]))) / length
+    return off > BEND_TOL * length
+
+
 def _gmsh_fill(units) -> tuple:
     """gmsh's quads for the rings at half resolution; local ids as free_face_quads."""
     with gmsh_session() as session:
@@ -114,7 +124,13 @@ def _gmsh_fill(units) -> tuple:
             sizes = 0.5 * (seg + np.roll(seg, 1))
             points = [geo.addPoint(float(x), float(y), 0.0, float(s))
                       for (x, y), s in zip(coarse, sizes)]
-            lines = [geo.addLine(points[k], points[(k + 1) % m]) for k in range(m)]
+            # Each side through the side node between its ends, so that gmsh meshes the
+            # true (curved) outline and its midpoint is that node's place.
+            middles = [geo.addPoint(float(x), float(y), 0.0, float(s))
+                       for (x, y), s in zip(unit[1::2], seg)]
+            lines = [geo.addSpline([points[k], middles[k], points[(k + 1) % m]])
+                     if _bends(coarse[k], unit[2 * k + 1], coarse[(k + 1) % m])
+                     else geo.addLine(points[k], points[(k + 1) % m]) for k in range(m)]
             loops.append(geo.addCurveLoop(lines))
             point_of.update({tag: offset + 2 * k for k, tag in enumerate(points)})
             line_of.update({tag: offset + 2 * k + 1 for k, tag in enumerate(lines)})

@@ -198,7 +198,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     from .subdivide import split_odd_faces
 
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
-    blocks, free = _with_holes(blocks, free, islands, edges)
+    blocks, free = _with_holes(blocks, free, islands, edges, element_size)
     singular = tuple(sorted(v for key, v in verts.by_key.items() if key[0] == "s"))
     return _used_vertices_only(Partition(vertices=np.array(vertices), edges=edges,
                                          blocks=blocks, cuts=list(cuts), singular=singular,
@@ -274,7 +274,7 @@ def _without_dangling(edges) -> list:
         edges = keep
 
 
-def _with_holes(blocks, free, islands, edges) -> tuple:
+def _with_holes(blocks, free, islands, edges, h) -> tuple:
     """(blocks, free faces) with each remaining island (a hole loop no streamline reaches
     any more) a hole of the smallest face around it; a block around one is no block."""
     if not islands:
@@ -285,7 +285,7 @@ def _with_holes(blocks, free, islands, edges) -> tuple:
     outlines = [_outline(edges, halves) for _, _, halves in faces]
     holes: dict = {}
     for island in islands:
-        probe = _outline(edges, island)[0]
+        probe = _left_of(_outline(edges, island), 1e-3 * h)
         around = [k for k, o in enumerate(outlines) if _inside_polygon(o, probe)]
         if not around:
             raise PartitionError(f"a loop near {_fmt(probe)} lies in no face")
@@ -300,6 +300,15 @@ def _with_holes(blocks, free, islands, edges) -> tuple:
         reason = free[index].reason if kind == "free" else "a block with a hole in it"
         out_free.append(FreeFace(halves, reason, tuple(holes[k])))
     return out_blocks, out_free
+
+
+def _left_of(outline, offset) -> np.ndarray:
+    """A point just left of the middle of the outline's longest segment: inside the
+    face the outline bounds, off the outline itself."""
+    d = np.diff(outline, axis=0)
+    k = int(np.argmax(np.hypot(*d.T)))
+    u = d[k] / np.hypot(*d[k])
+    return outline[k] + 0.5 * d[k] + offset * np.array([-u[1], u[0]])
 
 
 def _outline(edges, halves) -> np.ndarray:

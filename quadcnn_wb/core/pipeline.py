@@ -194,11 +194,16 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
             continue
         timings["quad_mesh"] += time.perf_counter() - clock
         sj = scaled_jacobians(mesh.nodes, mesh.quads)
-        folded = {_block_key(partition, int(b))
-                  for b in mesh.block_of_quad[sj <= MIN_VALID_JACOBIAN] if b >= 0}
-        if not folded or not allow_free or round_ == FREEING_ROUNDS:
+        bad = sj <= MIN_VALID_JACOBIAN
+        folded = {_block_key(partition, int(b)) for b in mesh.block_of_quad[bad] if b >= 0}
+        merged = {partition.edges[e].origin
+                  for f in np.unique(mesh.free_face_of_quad[bad]) if f >= 0
+                  for ring in partition.free_faces[f].rings for e, _ in ring
+                  if not partition.edges[e].is_boundary}
+        if not (folded or merged) or not allow_free or round_ == FREEING_ROUNDS:
             break
         freed |= folded
+        dissolve = dissolve | merged
     worst = sj.min() if len(sj) else 0.0
     if worst <= MIN_VALID_JACOBIAN:
         raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "

@@ -32,6 +32,7 @@ class QuadMesh:
     block_of_quad: np.ndarray  # (Q,)
     boundary: np.ndarray  # (N,) bool: node lies on the domain boundary
     edge_nodes: tuple  # per partition edge: node ids from its vertex a to vertex b
+    free_face_of_quad: np.ndarray = None  # (Q,) the partition's free face a quad fills, or -1
 
 
 def _boundary_edge_points(domain, edge, n: int) -> np.ndarray:
@@ -111,9 +112,10 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
         q = np.stack([grid[:-1, :-1], grid[1:, :-1], grid[1:, 1:], grid[:-1, 1:]], axis=-1)
         quads.append(q.reshape(-1, 4))
         owner.append(np.full(n * m, b))
+    free_owner = [np.full(len(q), -1) for q in quads]
     if partition.free_faces:
         pose = canonical_pose(domain)
-        for face in partition.free_faces:
+        for f, face in enumerate(partition.free_faces):
             try:
                 q = _free_face(layout, ids, positions, face, pose)
             except PartitionError as exc:
@@ -122,6 +124,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
                                                if not partition.edges[e].is_boundary]) from None
             quads.append(q)
             owner.append(np.full(len(q), -1))
+            free_owner.append(np.full(len(q), f))
     nodes = np.array(positions, dtype=float)
     quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
     owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
@@ -135,8 +138,9 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
     edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
                        for e, e_nodes in enumerate(layout.edge_nodes))
+    free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
-                    edge_nodes=edge_nodes)
+                    edge_nodes=edge_nodes, free_face_of_quad=free_owner)
 
 
 def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
