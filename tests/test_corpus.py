@@ -27,9 +27,9 @@ NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
 # The stand-in itself is invalid there: inverted elements, or quads that do not tile.
-INVALID_STAND_IN = {"perforated_plate", "bracket_plate"}
+INVALID_STAND_IN = {"perforated_plate"}
 # Only the faces that are no blocks get unstructured quads; the other faces keep theirs.
-PARTLY_BLOCKS = {"housing_rib", "crank_arm_web", "engine_bottom"}
+PARTLY_BLOCKS = {"housing_rib", "crank_arm_web", "engine_bottom", "motor_c_plate"}
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
 

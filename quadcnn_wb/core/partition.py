@@ -434,6 +434,33 @@ def _direction(points: np.ndarray, reach: float) -> np.ndarray:
     return d / n
 
 
+SECTOR_MARGIN = 1e-6  # radians inside the domain's sector a clamped direction is put
+
+
+def _into_the_domain(items, half, edges) -> None:
+    """At a boundary vertex, streamline directions that point out of the domain (a trace
+    leaving tangentially along a convex curve, measured by a chord) are put just inside
+    the sector between the two boundary edges: a face walk must never leak outside."""
+    boundary = [(angle, hid) for angle, hid in items if edges[half[hid][0]].is_boundary]
+    if len(boundary) != 2:
+        return
+    (a0, h0), (a1, h1) = boundary
+    out_angle, in_angle = (a0, a1) if half[h0][1] else (a1, a0)  # forward: leaves along loop
+    if half[h0][1] == half[h1][1]:
+        return
+    width = (in_angle - out_angle) % (2 * math.pi)
+    for k, (angle, hid) in enumerate(items):
+        if edges[half[hid][0]].is_boundary:
+            continue
+        offset = (angle - out_angle) % (2 * math.pi)
+        if offset <= width:
+            continue
+        past = offset - width  # beyond the incoming edge
+        before = 2 * math.pi - offset  # short of the outgoing edge
+        target = in_angle - SECTOR_MARGIN if past < before else out_angle + SECTOR_MARGIN
+        items[k] = (math.atan2(math.sin(target), math.cos(target)), hid)
+
+
 def _faces_to_blocks(vertices, edges, h):
     reach = 0.5 * h
     half = []  # (edge id, forward)
@@ -448,6 +475,7 @@ def _faces_to_blocks(vertices, edges, h):
             half.append((e, forward))
     order = {}
     for v, items in out_dirs.items():
+        _into_the_domain(items, half, edges)
         items.sort()
         for k, (_, hid) in enumerate(items):
             order[hid] = (v, k)

@@ -130,13 +130,22 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
             cuts, partition, counts, mesh = blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
     except PartitionError as exc:
-        # Never leave a valid input without a mesh, nor with one worse than gmsh's own:
-        # gmsh's quasi-structured quads stand in.
+        # Never leave a valid input without a mesh, nor with one worse than gmsh's own.
         problem = f"no block structure ({exc}); gmsh's quasi-structured quads stand in"
         cuts, partition, counts = [], Partition(np.zeros((0, 2)), [], [], []), np.zeros(0, int)
         clock = time.perf_counter()
         mesh = gmsh_quad_mesh(domain, size)
         timings["quad_mesh"] = time.perf_counter() - clock
+        if not is_valid_mesh(mesh):
+            # gmsh's own quads fold here: the domain as one free face stands in instead.
+            clock = time.perf_counter()
+            try:
+                cuts, partition, counts, mesh = blocks_and_mesh(
+                    domain, background, field, (), size, smoothing, {})
+                problem = f"no block structure ({exc}); unstructured quads stand in"
+            except PartitionError:
+                pass  # nothing better to be had: gmsh's mesh as it is
+            timings["quad_mesh"] += time.perf_counter() - clock
     problem = problem or free_face_problem(partition)
     clock = time.perf_counter()
     quality = mesh_quality(domain, mesh)
@@ -242,6 +251,14 @@ def free_face_problem(partition: Partition) -> str:
     reasons = sorted({face.reason.split(" near ")[0] for face in partition.free_faces})
     return (f"{len(partition.free_faces)} of {len(partition.free_faces) + len(partition.blocks)}"
             f" faces are no blocks ({'; '.join(reasons)}): unstructured quads there")
+
+
+def is_valid_mesh(mesh) -> bool:
+    """No inverted or degenerate quad, no overlap, no gap, no hole filled over."""
+    return bool(len(mesh.quads)) and scaled_jacobians(mesh.nodes, mesh.quads).min() > 0 \
+        and tiles_exactly(mesh.nodes, mesh.quads) \
+        and free_edges_on_boundary(mesh.quads, mesh.boundary) \
+        and boundary_on_free_edges(mesh.quads, mesh.boundary)
 
 
 def free_edges_on_boundary(quads, boundary) -> bool:

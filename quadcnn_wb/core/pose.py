@@ -53,6 +53,18 @@ def boundary_samples(domain) -> np.ndarray:
     return np.concatenate(points) if points else np.zeros((0, 2))
 
 
+def _hull(points: np.ndarray) -> np.ndarray:
+    """The convex hull's vertices (all the points where there is no 2D hull)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    if len(points) < 64:
+        return points
+    try:
+        return points[ConvexHull(points).vertices]
+    except QhullError:
+        return points
+
+
 def diameter(domain) -> float:
     """The largest distance across the part (rotation-invariant, unlike the bounding box
     diagonal; the same as it for rectangles)."""
@@ -61,7 +73,8 @@ def diameter(domain) -> float:
                if isinstance(c, Arc) and c.is_full]
     best = 0.0
     if len(points):
-        d = points[:, None, :] - points[None, :, :]
+        far = _hull(points)  # the farthest pair is a pair of hull vertices
+        d = far[:, None, :] - far[None, :, :]
         best = float(np.sqrt((d ** 2).sum(-1).max()))
     for centre, radius in circles:
         best = max(best, 2 * radius)
@@ -102,6 +115,18 @@ def area_centroid(domain) -> np.ndarray:
 
 
 def canonical_pose(domain) -> Pose:
+    """The pose of DESIGN's invariance rule; computed once per domain (it is asked for by
+    the background mesh, every free-face fill and the stand-in, and costs a scan of the
+    boundary), kept in the domain's own __dict__ (a frozen dataclass)."""
+    cached = getattr(domain, "__dict__", {}).get("_canonical_pose")
+    if cached is None:
+        cached = _canonical_pose(domain)
+        if hasattr(domain, "__dict__"):
+            domain.__dict__["_canonical_pose"] = cached
+    return cached
+
+
+def _canonical_pose(domain) -> Pose:
     points = boundary_samples(domain)
     circles = [c for loop in domain.loops for c in loop if isinstance(c, Arc) and c.is_full]
     center = area_centroid(domain)
