@@ -35,7 +35,7 @@ def free_face_quads(rings, pose) -> tuple:
         raise PartitionError(f"a free face near {_fmt(centre)} has {len(rings[0])} side "
                              "segments (an even number >= 6 is needed)")
     units, orders, offset = [], [], 0
-    for k, ring in enumerate(rings):
+    for ring in rings:
         unit = pose.to_unit(ring)
         order = np.arange(len(ring))
         if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
@@ -43,12 +43,12 @@ def free_face_quads(rings, pose) -> tuple:
         start = _start(unit[order])
         order = np.roll(order, -start)
         unit = unit[order]
-        if not is_simple(unit[0::2] if k == 0 else unit[0::2][::-1]):
-            raise PartitionError(f"a free face near {_fmt(centre)} touches or crosses "
-                                 "itself: no polygon to fill")
         units.append(unit)
         orders.append(order + offset)
         offset += len(ring)
+    if not rings_are_simple([u[0::2] for u in units]):
+        raise PartitionError(f"a free face near {_fmt(centre)} touches or crosses itself: "
+                             "no polygon to fill")
     interior, quads = _gmsh_fill(units)
     order = np.concatenate(orders)
     quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
@@ -61,15 +61,35 @@ SIMPLE_TOL = 1e-6  # share of the polygon's size: closer than this is touching
 def is_simple(polygon: np.ndarray) -> bool:
     """No two sides of the closed polygon cross or touch, except neighbours at their
     shared end, and it runs counter-clockwise (gmsh may hang on anything else)."""
-    p = np.asarray(polygon, dtype=float)
-    n = len(p)
-    a, b = p, np.roll(p, -1, axis=0)
-    area = 0.5 * float(np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]))
-    tol = SIMPLE_TOL * float(np.ptp(p, axis=0).max())
-    if n < 3 or not area > tol * tol:
-        return False
-    i, j = np.triu_indices(n, 2)
-    keep = ~((i == 0) & (j == n - 1))  # the last side and the first are neighbours
+    return rings_are_simple([polygon])
+
+
+def rings_are_simple(rings) -> bool:
+    """The outer ring counter-clockwise, the holes clockwise and inside it, and no two
+    sides of any rings crossing or touching except neighbours of one ring at their shared
+    end: a region gmsh can mesh (it may hang on anything else)."""
+    rings = [np.asarray(r, dtype=float) for r in rings]
+    every = np.concatenate(rings)
+    tol = SIMPLE_TOL * float(np.ptp(every, axis=0).max())
+    a, b, ring_of, index = [], [], [], []
+    for k, p in enumerate(rings):
+        n = len(p)
+        area = 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+        if n < 3 or not (area > tol * tol if k == 0 else -area > tol * tol):
+            return False
+        if k and not _inside(rings[0], p[0]):
+            return False
+        a.append(p)
+        b.append(np.roll(p, -1, axis=0))
+        ring_of.append(np.full(n, k))
+        index.append(np.arange(n))
+    a, b = np.concatenate(a), np.concatenate(b)
+    ring_of, index = np.concatenate(ring_of), np.concatenate(index)
+    size = np.array([len(r) for r in rings])[ring_of]
+    i, j = np.triu_indices(len(a), 1)
+    same = ring_of[i] == ring_of[j]
+    step = (index[j] - index[i]) % size[i]
+    keep = ~(same & ((step == 1) | (step == size[i] - 1)))  # neighbours share an end
     i, j = i[keep], j[keep]
 
     def orient(o, u, v):
@@ -90,6 +110,15 @@ def is_simple(polygon: np.ndarray) -> bool:
             if np.any(np.hypot(*(u + t[:, None] * d - q).T) <= tol):
                 return False
     return True
+
+
+def _inside(polygon, point) -> bool:
+    x, y = point
+    inside = False
+    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
 
 
 def _start(unit: np.ndarray) -> int:

@@ -187,7 +187,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = [dataclasses.replace(edge, origin=(edge.streamline, edge.a, edge.b))
              for edge in edges]
     edges = [edge for edge in edges if edge.is_boundary or edge.origin not in dissolve]
-    edges = _without_dangling(_without_doubles(edges, element_size))
+    edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
+                                               element_size))
     while True:
         faces, free, islands = _faces_to_blocks(np.array(verts.xy), edges, element_size)
         slits = _slits(free, edges) | {e for island in islands for e, _ in island
@@ -220,6 +221,37 @@ def _used_vertices_only(partition: Partition) -> Partition:
     return dataclasses.replace(partition, vertices=partition.vertices[used], edges=edges,
                                blocks=blocks,
                                singular=tuple(new[v] for v in partition.singular if v in new))
+
+
+ZERO_LENGTH = 1e-9  # a streamline edge shorter than this (element sizes) joins one place
+
+
+def _without_zero_length(edges, h) -> list:
+    """Streamline edges of no length dropped, their two ends made one vertex (a trace
+    stopping on another exactly at a vertex of it): no face walk can order an edge with
+    no direction.  A boundary vertex is the one kept."""
+    short = [e for e, edge in enumerate(edges)
+             if not edge.is_boundary and edge.length <= ZERO_LENGTH * h]
+    if not short:
+        return edges
+    on_boundary = {v for edge in edges if edge.is_boundary for v in (edge.a, edge.b)}
+    parent: dict = {}
+
+    def find(v):
+        while parent.get(v, v) != v:
+            v = parent[v]
+        return v
+
+    for e in short:
+        a, b = find(edges[e].a), find(edges[e].b)
+        if a == b:
+            continue
+        if b in on_boundary and a not in on_boundary:
+            a, b = b, a
+        parent[b] = a
+    dropped = set(short)
+    return [dataclasses.replace(edge, a=find(edge.a), b=find(edge.b))
+            for e, edge in enumerate(edges) if e not in dropped]
 
 
 DOUBLE_EDGE_GAP = 0.5  # two edges of the same ends closer than this (element sizes) are one
