@@ -12,7 +12,7 @@ export LANG := C.UTF-8
 export QTWEBENGINE_CHROMIUM_FLAGS := --no-sandbox
 
 .PHONY: help setup system-packages venv link demo test lint bench learning-figures models \
-	robustness clean
+	robustness families clean
 
 help:
 	@echo "make demo   - set up, then mesh a bundled example and write pictures to $(OUT)/"
@@ -23,6 +23,7 @@ help:
 	@echo "make learning-figures - Table 2 of the paper with our models, cnn vs numerical"
 	@echo "make models - regenerate the data sets and retrain the shipped models (hours)"
 	@echo "make robustness - the 500-shape random robustness campaign"
+	@echo "make families - 200 fresh random members of every shape family, numerical path"
 
 setup: system-packages $(STAMP) link
 
@@ -105,3 +106,6 @@ robustness: setup
 
 clean:
 	rm -rf $(OUT) .pytest_cache .ruff_cache
+
+families: setup
+	$(PY) -m quadcnn_wb.bench.families -n 200 --workers 2

@@ -136,3 +136,13 @@ def test_time_limit_is_a_clear_error_and_leaves_no_file(tmp_path):
     assert result.returncode == 2
     assert result.stderr.startswith("error: gave up after 0.2 s"), result.stderr
     assert not out.exists()
+
+
+def test_family_benchmark_meshes_fresh_members_and_reports():
+    from quadcnn_wb.bench.families import report, run_member
+
+    rows = [run_member(name, 5, 0) for name in ("l_shape", "four_hole")]
+    assert all(r["structured"] and r["valid"] and r["share"] == 1.0 for r in rows), rows
+    assert all(r["extra_irregular"] == 0 for r in rows)
+    text = report(rows)
+    assert text.splitlines()[0].startswith("family") and "four_hole" in text
