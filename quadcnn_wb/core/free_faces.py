@@ -19,7 +19,7 @@ import gmsh
 import numpy as np
 
 from .gmsh_session import gmsh_session, silenced_stdio
-from .partition import PartitionError, _fmt
+from .partition import PartitionError, _fmt, inside_polygon
 
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 
@@ -77,7 +77,7 @@ def rings_are_simple(rings) -> bool:
         area = 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
         if n < 3 or not (area > tol * tol if k == 0 else -area > tol * tol):
             return False
-        if k and not _inside(rings[0], p[0]):
+        if k and not inside_polygon(rings[0], p[0]):
             return False
         a.append(p)
         b.append(np.roll(p, -1, axis=0))
@@ -110,15 +110,6 @@ def rings_are_simple(rings) -> bool:
             if np.any(np.hypot(*(u + t[:, None] * d - q).T) <= tol):
                 return False
     return True
-
-
-def _inside(polygon, point) -> bool:
-    x, y = point
-    inside = False
-    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
 
 
 def _start(unit: np.ndarray) -> int:

@@ -318,7 +318,7 @@ def _with_holes(blocks, free, islands, edges, h) -> tuple:
     holes: dict = {}
     for island in islands:
         probe = _left_of(_outline(edges, island), 1e-3 * h)
-        around = [k for k, o in enumerate(outlines) if _inside_polygon(o, probe)]
+        around = [k for k, o in enumerate(outlines) if inside_polygon(o, probe)]
         if not around:
             raise PartitionError(f"a loop near {_fmt(probe)} lies in no face")
         k = min(around, key=lambda k: abs(_polygon_area(outlines[k])))
@@ -353,7 +353,8 @@ def _polygon_area(pts) -> float:
                               - np.roll(pts[:, 0], -1) * pts[:, 1]))
 
 
-def _inside_polygon(polygon, p) -> bool:
+def inside_polygon(polygon, p) -> bool:
+    """Even-odd rule: p strictly inside the closed polygon (points on it: either way)."""
     x, y = p
     inside = False
     for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):

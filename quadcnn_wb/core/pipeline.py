@@ -168,7 +168,7 @@ FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable f
 
 
 def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
-                     allow_free=True):
+                    allow_free=True):
     """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
     can be had from these streamlines.  Faces that are no blocks, and blocks whose map
     gives a degenerate element, get unstructured quads (free faces); a free face that
@@ -227,9 +227,9 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
 
 
 def _block_key(partition: Partition, b: int) -> frozenset:
-    """A block named by its corner places, which a rebuild keeps."""
-    return frozenset(tuple(np.round(partition.vertices[c], 12)) for c in
-                     partition.blocks[b].corners)
+    """A block named by its corner places, which a rebuild of the same input repeats
+    exactly (vertex numbers may change when other edges go)."""
+    return frozenset(tuple(partition.vertices[c].tolist()) for c in partition.blocks[b].corners)
 
 
 def free_blocks(partition: Partition, chosen, reason: str) -> Partition:

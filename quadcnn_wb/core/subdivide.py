@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt, _inside_polygon
+from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt, inside_polygon
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
@@ -32,7 +32,7 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
             mids.append(_split_side(vertices, edges, everything, sides, j, domain))
         centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
         polygon = np.array([vertices[c] for c in corners])
-        if not _inside_polygon(polygon, centre):
+        if not inside_polygon(polygon, centre):
             halves = [h for side in sides for h in side]
             free_halves.append((halves, f"a {len(corners)}-cornered block near "
                                 f"{_fmt(centre)} is too concave to split into "
