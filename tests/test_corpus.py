@@ -29,7 +29,8 @@ NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
 # The stand-in itself is invalid there: inverted elements, or quads that do not tile.
 INVALID_STAND_IN = {"perforated_plate"}
 # Only the faces that are no blocks get unstructured quads; the other faces keep theirs.
-PARTLY_BLOCKS = {"housing_rib", "crank_arm_web", "engine_bottom", "motor_c_plate"}
+PARTLY_BLOCKS = {"housing_rib", "crank_arm_web", "engine_bottom", "motor_c_plate", "io1_flange",
+                 "sketch_gasket"}
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
 

@@ -20,7 +20,7 @@ from .layout.motorcycle import stop_at_first_hits
 from .layout.quantize import quantize, quantize_freeing
 from .partition import FreeFace, FreeFaceError, Partition, PartitionError, build_partition
 from .pose import diameter
-from .quadmesh import QuadMesh, build_quad_mesh, scaled_jacobians
+from .quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
 from .quality import mesh_quality, structured_share
 from .reference import Reference, background_and_field
 from .tracing import trace_streamlines
@@ -201,9 +201,17 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
                 raise PartitionError(str(exc)) from None
             dissolve = dissolve | exc.origins
             continue
+        except SquashedBlocks as exc:
+            timings["quad_mesh"] += time.perf_counter() - clock
+            if not exc.blocks or not allow_free or round_ == FREEING_ROUNDS:
+                raise
+            freed |= {_block_key(partition, b) for b in exc.blocks}
+            continue
         timings["quad_mesh"] += time.perf_counter() - clock
         sj = scaled_jacobians(mesh.nodes, mesh.quads)
         bad = sj <= MIN_VALID_JACOBIAN
+        if not tiles_exactly(mesh.nodes, mesh.quads):
+            bad |= crossing_quads(mesh.nodes, mesh.quads)  # blocks folded over others
         folded = {_block_key(partition, int(b)) for b in mesh.block_of_quad[bad] if b >= 0}
         merged = {partition.edges[e].origin
                   for f in np.unique(mesh.free_face_of_quad[bad]) if f >= 0
@@ -251,6 +259,35 @@ def free_face_problem(partition: Partition) -> str:
     reasons = sorted({face.reason.split(" near ")[0] for face in partition.free_faces})
     return (f"{len(partition.free_faces)} of {len(partition.free_faces) + len(partition.blocks)}"
             f" faces are no blocks ({'; '.join(reasons)}): unstructured quads there")
+
+
+def crossing_quads(nodes, quads) -> np.ndarray:
+    """Quads with an edge that crosses another quad's edge: where blocks fold over each
+    other though every element is positive."""
+    directed = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    owner = np.tile(np.arange(len(quads)), 4)
+    key = np.sort(directed, axis=1)
+    edges = np.unique(key, axis=0)
+    a, b = nodes[edges[:, 0]], nodes[edges[:, 1]]
+    reach = float(np.hypot(*(b - a).T).max())
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(0.5 * (a + b)).query_pairs(reach, output_type="ndarray")
+    i, j = pairs[:, 0], pairs[:, 1]
+    shared = (edges[i][:, :, None] == edges[j][:, None, :]).any(axis=(1, 2))
+    i, j = i[~shared], j[~shared]
+
+    def orient(o, u, v):
+        return (u[:, 0] - o[:, 0]) * (v[:, 1] - o[:, 1]) - (u[:, 1] - o[:, 1]) * (v[:, 0] - o[:, 0])
+
+    cross = (orient(a[i], b[i], a[j]) * orient(a[i], b[i], b[j]) < 0) \
+        & (orient(a[j], b[j], a[i]) * orient(a[j], b[j], b[i]) < 0)
+    hit = np.zeros(len(edges), dtype=bool)
+    hit[i[cross]] = hit[j[cross]] = True
+    bad = np.zeros(len(quads), dtype=bool)
+    _, inverse = np.unique(key, axis=0, return_inverse=True)
+    bad[owner[hit[inverse.ravel()]]] = True
+    return bad
 
 
 def is_valid_mesh(mesh) -> bool:

@@ -128,9 +128,11 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     nodes = np.array(positions, dtype=float)
     quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
     owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
-    if len(quads) and (np.sort(quads, axis=1)[:, 1:] == np.sort(quads, axis=1)[:, :-1]).any():
-        raise PartitionError("the segment counts squash a block into a quad with a repeated "
-                             "corner")
+    ordered = np.sort(quads, axis=1)
+    squashed = (ordered[:, 1:] == ordered[:, :-1]).any(axis=1)
+    if squashed.any():
+        raise SquashedBlocks("the segment counts squash a block into a quad with a repeated "
+                             "corner", sorted({int(b) for b in owner[squashed] if b >= 0}))
     boundary = np.zeros(len(nodes), dtype=bool)
     boundary[list(boundary_ids)] = True
     quads = _counter_clockwise(nodes, quads)
@@ -141,6 +143,14 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
                     edge_nodes=edge_nodes, free_face_of_quad=free_owner)
+
+
+class SquashedBlocks(PartitionError):
+    """Blocks (indices) that the segment counts squash: freeing them may help."""
+
+    def __init__(self, message, blocks):
+        super().__init__(message)
+        self.blocks = blocks
 
 
 def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
