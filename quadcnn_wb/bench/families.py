@@ -23,22 +23,14 @@ def run_member(name: str, seed: int, index: int) -> dict:
     """Member `index` of family `name` for campaign `seed`, meshed and checked."""
     from ..core.pipeline import mesh_domain
     from ..learn.families import family
-    from .meshcheck import MeshDefect, check_quad_mesh
+    from .meshcheck import MeshDefect, check_domain_mesh
 
     _, domain = family(name).sample(np.random.default_rng([seed, index]))
     start = time.perf_counter()
     result = mesh_domain(domain)
     seconds = time.perf_counter() - start
-    mesh = result.mesh
-    tol = 1e-9 * domain.size
-    curves = [c for loop in domain.loops for c in loop]
-
-    def on_boundary(p):
-        return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol for c in curves)
-
-    arcs = [(np.asarray(c.center), c.radius) for c in curves if hasattr(c, "radius")]
     try:
-        check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs)
+        check_domain_mesh(domain, result.mesh)
         defect = ""
     except MeshDefect as exc:
         defect = str(exc)

@@ -87,3 +87,16 @@ def check_quad_mesh(nodes, quads, domain_area, on_boundary, arcs=()):
     used = np.unique(quads)
     _require(len(used) == len(nodes), "unused nodes")
     return boundary_edges
+
+
+def check_domain_mesh(domain, mesh) -> None:
+    """check_quad_mesh for a mesh of a Domain: boundary nodes within 1e-9 of the part's
+    size of its exact curves, chord allowance from its arcs.  Raises MeshDefect."""
+    tol = 1e-9 * domain.size
+    curves = [c for loop in domain.loops for c in loop]
+
+    def on_boundary(p):
+        return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol for c in curves)
+
+    arcs = [(np.asarray(c.center), c.radius) for c in curves if hasattr(c, "radius")]
+    check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs)

@@ -28,7 +28,7 @@ def run_one(seed: int, index: int) -> dict:
     """Draw shape `index` of campaign `seed`, mesh it, check it; never raises."""
     from ..core.domain import DomainError, domain_from_json
     from ..core.pipeline import mesh_domain
-    from .meshcheck import MeshDefect, check_quad_mesh
+    from .meshcheck import MeshDefect, check_domain_mesh
     from .random_shapes import random_shape
 
     rng = np.random.default_rng([seed, index])
@@ -45,15 +45,8 @@ def run_one(seed: int, index: int) -> dict:
         return {**row, "outcome": "failed", "reason": f"{type(exc).__name__}: {_reason(exc)}"}
     row["seconds"] = time.perf_counter() - start
     mesh = result.mesh
-    tol = 1e-9 * domain.size
-    curves = [c for loop in domain.loops for c in loop]
-
-    def on_boundary(p):
-        return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol for c in curves)
-
-    arcs = [(np.asarray(c.center), c.radius) for c in curves if hasattr(c, "radius")]
     try:
-        check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs)
+        check_domain_mesh(domain, mesh)
     except MeshDefect as exc:
         return {**row, "outcome": "invalid mesh", "reason": str(exc)}
     outcome = "valid, block-structured" if result.structured else \
