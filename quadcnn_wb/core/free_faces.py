@@ -58,12 +58,6 @@ def free_face_quads(rings, pose) -> tuple:
 SIMPLE_TOL = 1e-6  # share of the polygon's size: closer than this is touching
 
 
-def is_simple(polygon: np.ndarray) -> bool:
-    """No two sides of the closed polygon cross or touch, except neighbours at their
-    shared end, and it runs counter-clockwise (gmsh may hang on anything else)."""
-    return rings_are_simple([polygon])
-
-
 def rings_are_simple(rings) -> bool:
     """The outer ring counter-clockwise, the holes clockwise and inside it, and no two
     sides of any rings crossing or touching except neighbours of one ring at their shared

@@ -109,6 +109,10 @@ class _Problem:
                                 [lo for _, lo, _ in rows], [up for _, _, up in rows])
 
 
+class InfeasibleCounts(PartitionError):
+    """No counts make every block's opposite sides equal (HiGHS: the model is infeasible)."""
+
+
 def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.ndarray:
     """Integer segment count per edge of the partition, every block kept (PartitionError
     when no counts make all blocks' opposite sides equal)."""
@@ -121,10 +125,8 @@ def quantize_freeing(partition: Partition, size: float, time_limit: float = 20.0
     case, and the faster program), else as few given up as the traces force."""
     try:
         return _solve(partition, size, time_limit, free_blocks=False)
-    except PartitionError as exc:
-        if "infeasible" not in str(exc):
-            raise
-    return _solve(partition, size, time_limit, free_blocks=True)
+    except InfeasibleCounts:
+        return _solve(partition, size, time_limit, free_blocks=True)
 
 
 def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bool) -> tuple:
@@ -200,8 +202,9 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
                       integrality=integrality, bounds=bounds,
                       options={"time_limit": time_limit})
         if result.x is None:
-            raise PartitionError(f"no segment counts make opposite block sides equal "
-                                 f"({result.message})")
+            error = InfeasibleCounts if result.status == 2 else PartitionError  # 2: infeasible
+            raise error(f"no segment counts make opposite block sides equal "
+                        f"({result.message})")
         if result.status != 0:  # a time-limited answer would depend on the machine's speed
             raise PartitionError(f"the segment-count program found no proven optimum "
                                  f"within {time_limit:g} s ({result.message})")
