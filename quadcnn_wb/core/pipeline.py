@@ -177,9 +177,12 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     False (the cnn path: its lines are then not trusted)."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
     dissolve, freed = frozenset(), set()
+    clock = time.perf_counter()
+    cuts = connecting_cuts(domain, background, field, lines)  # the same in every round
+    timings["partition"] += time.perf_counter() - clock
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
-        cuts, partition = _partition(domain, background, field, lines, dissolve)
+        partition = build_partition(domain, lines, background.element_size, cuts, dissolve)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")
@@ -337,8 +340,3 @@ def tiles_exactly(nodes, quads) -> bool:
     a, b = nodes[free[:, 0]], nodes[free[:, 1]]
     enclosed = 0.5 * np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1])
     return bool(abs(area - enclosed) <= 1e-9 * max(abs(enclosed), 1e-300))
-
-
-def _partition(domain, background, field, lines, dissolve=frozenset()):
-    cuts = connecting_cuts(domain, background, field, lines)
-    return cuts, build_partition(domain, lines, background.element_size, cuts, dissolve)
