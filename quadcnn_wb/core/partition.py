@@ -187,6 +187,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = [dataclasses.replace(edge, origin=(edge.streamline, edge.a, edge.b))
              for edge in edges]
     edges = [edge for edge in edges if edge.is_boundary or edge.origin not in dissolve]
+    singular = {v for key, v in verts.by_key.items() if key[0] == "s"}
+    edges = _one_vertex_per_place(edges, np.array(verts.xy), element_size, singular)
     edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
                                                element_size))
     while True:
@@ -200,7 +202,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
 
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
-    singular = tuple(sorted(v for key, v in verts.by_key.items() if key[0] == "s"))
+    used = {v for edge in edges for v in (edge.a, edge.b)}
+    singular = tuple(sorted(singular & used))
     return _used_vertices_only(Partition(vertices=np.array(vertices), edges=edges,
                                          blocks=blocks, cuts=list(cuts), singular=singular,
                                          free_faces=free))
@@ -223,7 +226,43 @@ def _used_vertices_only(partition: Partition) -> Partition:
                                singular=tuple(new[v] for v in partition.singular if v in new))
 
 
-ZERO_LENGTH = 1e-9  # a streamline edge shorter than this (element sizes) joins one place
+def _one_vertex_per_place(edges, xy, h, singular) -> list:
+    """Vertices in one place (a trace ending exactly on a singular point, a crossing on a
+    T-junction) made one: two vertices there would let a face's walk jump between them
+    without an edge, and the face's quads leave a gap.  A boundary vertex, else a singular
+    point, is the one kept."""
+    if len(xy) < 2:
+        return edges
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(xy).query_pairs(SAME_PLACE * h, output_type="ndarray")
+    if not len(pairs):
+        return edges
+    on_boundary = {v for edge in edges if edge.is_boundary for v in (edge.a, edge.b)}
+
+    def rank(v):
+        return (v not in on_boundary, v not in singular, v)
+
+    parent = {}
+
+    def find(v):
+        while parent.get(v, v) != v:
+            v = parent[v]
+        return v
+
+    for a, b in sorted(map(tuple, pairs.tolist())):
+        ra, rb = find(a), find(b)
+        if ra == rb or (ra in on_boundary and rb in on_boundary):
+            continue  # two boundary places are the outline's own business
+        keep, drop = sorted((ra, rb), key=rank)
+        parent[drop] = keep
+    if not parent:
+        return edges
+    return [dataclasses.replace(edge, a=find(edge.a), b=find(edge.b))
+            if edge.a in parent or edge.b in parent else edge for edge in edges]
+
+
+ZERO_LENGTH = 1e-6  # streamline edges shorter than this (element sizes) join their ends
 
 
 def _without_zero_length(edges, h) -> list:

@@ -115,16 +115,20 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     free_owner = [np.full(len(q), -1) for q in quads]
     if partition.free_faces:
         pose = canonical_pose(domain)
-        for f, face in enumerate(partition.free_faces):
+        failed, origins = [], set()  # every face that cannot be filled, so one rebuild
+        for f, face in enumerate(partition.free_faces):  # can merge them all
             try:
                 q = _free_face(layout, ids, positions, face, pose)
             except PartitionError as exc:
-                raise FreeFaceError(str(exc), [partition.edges[e].origin
-                                               for ring in face.rings for e, _ in ring
-                                               if not partition.edges[e].is_boundary]) from None
+                failed.append(str(exc))
+                origins |= {partition.edges[e].origin for ring in face.rings for e, _ in ring
+                            if not partition.edges[e].is_boundary}
+                continue
             quads.append(q)
             owner.append(np.full(len(q), -1))
             free_owner.append(np.full(len(q), f))
+        if failed:
+            raise FreeFaceError(failed[0], origins)
     nodes = np.array(positions, dtype=float)
     quads = np.concatenate(quads) if quads else np.zeros((0, 4), dtype=np.int64)
     owner = np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64)
@@ -167,14 +171,40 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
         raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
     xy = np.array(positions)
     interior, local = free_face_quads([xy[r] for r in rings], pose)
-    corners = np.vstack([xy[every], interior])[local]
-    if _sj_batch(corners).min() <= 0 and _sj_batch(corners[:, ::-1]).min() <= 0:
-        raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
-                             "curved sides")
+    points = np.vstack([xy[every], interior])
+    if _total_area(points, local) < 0:
+        local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
+    if _sj_batch(points[local]).min() <= 0:
+        points = _untangled(points, local, len(every))
+        if _sj_batch(points[local]).min() <= 0:
+            raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
+                                 "curved sides")
+        interior = points[len(every):]
     first = len(positions)
     positions.extend(interior)
     return np.where(local < len(every), every[np.minimum(local, len(every) - 1)],
                     local - len(every) + first)
+
+
+UNTANGLE_PASSES = 30
+
+
+def _untangled(points, local, n_ring) -> np.ndarray:
+    """gmsh's quads for a thin or strongly curved free face, with its interior nodes moved
+    (max-min compass search, the side nodes fixed) until no quad is inverted if that can
+    be had: gmsh places them for the straightened outline, the neighbours' side nodes
+    bend it.  ``local``: all counter-clockwise, so an inverted quad reads negative."""
+    fixed = np.zeros(len(points), dtype=bool)
+    fixed[:n_ring] = True
+    if fixed.all():
+        return points
+    return improve_worst(points, local, fixed, passes=UNTANGLE_PASSES, share=1.0)
+
+
+def _total_area(points, quads) -> float:
+    p = points[quads]
+    return 0.5 * float(np.sum(p[..., 0] * np.roll(p[..., 1], -1, axis=-1)
+                              - np.roll(p[..., 0], -1, axis=-1) * p[..., 1]))
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:

@@ -26,10 +26,11 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
     blocks = []
     free_halves = [(list(f.halves), f.reason) for f in free]
     everything = list(faces) + [(None, [halves]) for halves, _ in free_halves]
-    for corners, sides in odd:
-        mids = []
-        for j in range(len(sides)):
-            mids.append(_split_side(vertices, edges, everything, sides, j, domain))
+    # Every side's middle first: a later face's split cuts an edge of an earlier face's
+    # side too, and that face's blocks must be made from its sides as finally cut.
+    all_mids = [[_split_side(vertices, edges, everything, sides, j, domain)
+                 for j in range(len(sides))] for _, sides in odd]
+    for (corners, sides), mids in zip(odd, all_mids):
         centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
         polygon = np.array([vertices[c] for c in corners])
         if not inside_polygon(polygon, centre):
