@@ -198,7 +198,26 @@ def _untangled(points, local, n_ring) -> np.ndarray:
     fixed[:n_ring] = True
     if fixed.all():
         return points
+    # Plain Laplacian first (a fold where a curved side bulges into gmsh's centre nodes
+    # needs them pulled towards their neighbours), kept only where it does better.
+    relaxed = _laplacian(points, local, fixed, UNTANGLE_PASSES)
+    if _sj_batch(relaxed[local]).min() > _sj_batch(points[local]).min():
+        points = relaxed
     return improve_worst(points, local, fixed, passes=UNTANGLE_PASSES, share=1.0)
+
+
+def _laplacian(points, quads, fixed, iterations) -> np.ndarray:
+    edges = np.unique(np.sort(np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)]),
+                              axis=1), axis=0)
+    degree = np.bincount(edges.ravel(), minlength=len(points)).astype(float)
+    free = ~fixed & (degree > 0)
+    x = points.copy()
+    for _ in range(iterations):
+        summed = np.zeros_like(x)
+        np.add.at(summed, edges[:, 0], x[edges[:, 1]])
+        np.add.at(summed, edges[:, 1], x[edges[:, 0]])
+        x[free] = summed[free] / degree[free, None]
+    return x
 
 
 def _total_area(points, quads) -> float:

@@ -161,8 +161,12 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
     rows = []
     rows.extend(({v: 1, 2 * n_edges + v: -2}, 0, 0) for v in free_edges)
     for face in partition.free_faces:
-        rows.append(({2 * n_edges + int(position[e]): 1 for e, _ in face.halves},
-                     MIN_FREE_FACE_HALVES, np.inf))
+        for ring in face.rings:  # a hole as well as the outline (a 2-point hole is none)
+            row: dict = {}
+            for e, _ in ring:
+                row[2 * n_edges + int(position[e])] = row.get(2 * n_edges + int(position[e]),
+                                                              0) + 1
+            rows.append((row, MIN_FREE_FACE_HALVES, np.inf))
     for b in block_order:
         block = partition.blocks[b]
         z = z_col[b]
