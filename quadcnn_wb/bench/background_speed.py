@@ -13,9 +13,9 @@ import time
 
 import gmsh
 
-from ..core.background import GMSH_ALGORITHM, _build_geometry, background_mesh
+from ..core.field.background import GMSH_ALGORITHM, _build_geometry, background_mesh
 from ..core.gmsh_session import gmsh_session
-from ..core.pose import canonical_pose
+from ..core.input.pose import canonical_pose
 from .common import bundled_examples, parse_options
 
 

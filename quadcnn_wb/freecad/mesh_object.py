@@ -95,7 +95,7 @@ class QuadMeshProxy(Stateless):
             ViewProviderQuadMesh(obj.ViewObject)
 
     def execute(self, obj):
-        from ..core.domain import DomainError
+        from ..core.input.domain import DomainError
         from ..core.pipeline import mesh_domain
         from .geometry import face_to_domain, source_shape_and_placement, to_global
         from .mesh_builder import fem_mesh, update_companions

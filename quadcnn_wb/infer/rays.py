@@ -172,7 +172,7 @@ class CrossField:
     triangle with the nearest centroid; points off the mesh take cross_angle_at."""
 
     def __init__(self, nodes, triangles, theta, walker=None, centroids=None, tree=None):
-        from ..core.meshwalk import MeshWalker
+        from ..core.field.meshwalk import MeshWalker
 
         self.tree = tree if tree is not None else cKDTree(nodes)
         self.centroids = centroids if centroids is not None \
@@ -220,7 +220,7 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
     the labels' own rule applied to the rays (1: a ray crosses a triangle of the node
     heading along that vector).  `field`: the cross field on these nodes, when the caller
     has one (CrossField.on a mesh shares its point location)."""
-    from ..core.labels import crossed_labels, resample
+    from ..core.field.labels import crossed_labels, resample
 
     out = np.ones((len(nodes), len(FEATURES)))
     out[:, 4:] = 0.0

@@ -30,8 +30,8 @@ import numpy as np
 from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
-from ..core.curves import winding_numbers
-from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
+from ..core.input.curves import winding_numbers
+from ..core.layout.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
 from .rays import CrossField
 
 NEIGHBOURS = 12  # m of the paper
@@ -351,7 +351,7 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
 
     Returns (streamlines, problems): each problem is (source description, reason).
     """
-    from ..core.tracing import _one_line_per_separatrix, _snap_targets, _sources, integrate
+    from ..core.layout.tracing import _one_line_per_separatrix, _snap_targets, _sources, integrate
 
     h = mesh.element_size
     walker = mesh.walker

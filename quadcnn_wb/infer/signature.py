@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from ..core.background import CORNER_MIN_TURN, _interior_angle
+from ..core.field.background import CORNER_MIN_TURN, _interior_angle
 
 
 def loop_corners(loop) -> list[int]:

@@ -18,10 +18,10 @@ import gmsh
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .curves import Arc, cross2
-from .domain import Domain
-from .gmsh_session import gmsh_session
-from .pose import KEY_DIGITS, Pose, canonical_pose
+from ..gmsh_session import gmsh_session
+from ..input.curves import Arc, cross2
+from ..input.domain import Domain
+from ..input.pose import KEY_DIGITS, Pose, canonical_pose
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .layout.crossings import crossings, end_places
+from .crossings import crossings, end_places
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
 

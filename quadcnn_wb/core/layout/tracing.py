@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .background import BackgroundMesh
-from .curves import Arc
-from .domain import Domain
-from .framefield import FrameField
+from ..field.background import BackgroundMesh
+from ..field.framefield import FrameField
+from ..input.curves import Arc
+from ..input.domain import Domain
 
 STEP = 0.25  # integration step, in element sizes
 SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes

@@ -18,8 +18,8 @@ from __future__ import annotations
 import gmsh
 import numpy as np
 
-from .gmsh_session import gmsh_session, silenced_stdio
-from .partition import PartitionError, _fmt, inside_polygon
+from ..gmsh_session import gmsh_session, silenced_stdio
+from ..layout.partition import PartitionError, _fmt, inside_polygon
 
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 

@@ -18,9 +18,9 @@ import time
 import gmsh
 import numpy as np
 
-from .background import _build_geometry
-from .gmsh_session import gmsh_session, silenced_stdio
-from .pose import Pose, canonical_pose
+from ..field.background import _build_geometry
+from ..gmsh_session import gmsh_session, silenced_stdio
+from ..input.pose import Pose, canonical_pose
 from .quadmesh import QuadMesh, _counter_clockwise
 from .quality import min_scaled_jacobian
 

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..input.pose import canonical_pose
+from ..layout.collapse import conflicts, merges, node_layout, side_nodes
+from ..layout.partition import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_quads
-from .layout.collapse import conflicts, merges, node_layout, side_nodes
-from .partition import FreeFaceError, Partition, PartitionError
-from .pose import canonical_pose
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3

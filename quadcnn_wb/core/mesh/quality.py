@@ -7,7 +7,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .background import _interior_angle
+from ..field.background import _interior_angle
 from .quadmesh import scaled_jacobians
 
 
