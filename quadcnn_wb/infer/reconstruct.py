@@ -31,7 +31,8 @@ from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
 from ..core.input.curves import winding_numbers
-from ..core.layout.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
+from ..core.layout.streamlines import Endpoint, Streamline
+from ..core.layout.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE
 from .rays import CrossField
 
 NEIGHBOURS = 12  # m of the paper

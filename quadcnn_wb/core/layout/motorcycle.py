@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .crossings import crossings, cumulative_length, end_places
-from .tracing import Endpoint
+from .streamlines import Endpoint
 
 SOURCE_KINDS = ("singularity", "corner")
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -22,6 +21,7 @@ from ..field.background import BackgroundMesh
 from ..field.framefield import FrameField
 from ..input.curves import Arc
 from ..input.domain import Domain
+from .streamlines import Endpoint, Streamline
 
 STEP = 0.25  # integration step, in element sizes
 SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes
@@ -29,43 +29,6 @@ CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the co
 MAX_LENGTH = 4.0  # streamlines longer than this many domain diagonals are capped
 SNAP_ANGLE = math.radians(45)  # an approach must be this close to a separatrix to snap
 MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
-
-
-@dataclass(frozen=True)
-class Endpoint:
-    kind: str  # "singularity", "corner", "boundary" or "streamline" (a T-junction)
-    index: int = -1  # singularity index, background node of the corner, or streamline index
-    loop: int = -1  # for corner and boundary ends: where on the boundary
-    segment: int = -1
-    param: float = -1.0
-    branch: int = -1  # at a singular point: which of its separatrix directions
-
-    def same_place(self, other) -> bool:
-        return (self.kind, self.index) == (other.kind, other.index)
-
-    def to_json(self) -> dict:
-        out = {"kind": self.kind}
-        if self.index >= 0:
-            out["index"] = self.index
-        if self.branch >= 0:
-            out["branch"] = self.branch
-        if self.loop >= 0:
-            out.update(loop=self.loop, segment=self.segment, param=self.param)
-        return out
-
-
-@dataclass(frozen=True)
-class Streamline:
-    points: np.ndarray  # (M, 2) polyline from start to end
-    start: Endpoint
-    end: Endpoint
-    capped: bool = False
-    start_direction: np.ndarray = field(default=None, compare=False)
-    fallback: bool = False  # traced numerically because the cnn reconstruction failed
-
-    @property
-    def length(self) -> float:
-        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
 
 
 class _BoundaryIndex:
