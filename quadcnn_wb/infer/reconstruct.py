@@ -31,8 +31,16 @@ from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
 from ..core.input.curves import winding_numbers
+from ..core.layout.field_rules import (
+    MAX_LENGTH,
+    SNAP,
+    SNAP_ANGLE,
+    one_line_per_separatrix,
+    separatrix_sources,
+    snap_targets,
+)
 from ..core.layout.streamlines import Endpoint, Streamline
-from ..core.layout.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE
+from ..core.layout.tracing import integrate
 from .rays import CrossField
 
 NEIGHBOURS = 12  # m of the paper
@@ -352,15 +360,13 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
 
     Returns (streamlines, problems): each problem is (source description, reason).
     """
-    from ..core.layout.tracing import _one_line_per_separatrix, _snap_targets, _sources, integrate
-
     h = mesh.element_size
     walker = mesh.walker
-    sources = _sources(mesh, field, walker, h)
+    sources = separatrix_sources(mesh, field, walker, h)
     vectors = LabelledVectors(mesh.nodes, field.frames, labels)
     boundary_ids = mesh.boundary_nodes
     boundary_tree = cKDTree(mesh.nodes[boundary_ids])
-    targets, target_kind = _snap_targets(mesh, field)
+    targets, target_kind = snap_targets(mesh, field)
     field_between = CrossField.on(mesh, field.theta)
     lines, failed, problems = [], [], []
     walks = walk_labels(domain, mesh, field, vectors, sources, boundary_tree, boundary_ids,
@@ -377,4 +383,4 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
     if failed:
         traced = integrate(domain, mesh, field, failed, walker)
         lines.extend(dataclasses.replace(line, fallback=True) for line in traced)
-    return tuple(_one_line_per_separatrix(lines, h)), problems
+    return tuple(one_line_per_separatrix(lines, h)), problems

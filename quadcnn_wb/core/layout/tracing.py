@@ -11,9 +11,6 @@ vectorised, so tracing a whole field costs about as much as tracing one.
 
 from __future__ import annotations
 
-import dataclasses
-import math
-
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -21,14 +18,22 @@ from ..field.background import BackgroundMesh
 from ..field.framefield import FrameField
 from ..input.curves import Arc
 from ..input.domain import Domain
+from .field_rules import (
+    MAX_LENGTH,
+    SNAP,
+    SNAP_CANDIDATES,
+    arrives_along,
+    cross_angle,
+    may_snap,
+    nearest_arm,
+    one_line_per_separatrix,
+    separatrix_sources,
+    snap_targets,
+)
 from .streamlines import Endpoint, Streamline
 
 STEP = 0.25  # integration step, in element sizes
-SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes
 CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the corner
-MAX_LENGTH = 4.0  # streamlines longer than this many domain diagonals are capped
-SNAP_ANGLE = math.radians(45)  # an approach must be this close to a separatrix to snap
-MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
 
 
 class _BoundaryIndex:
@@ -90,22 +95,14 @@ class _BoundaryIndex:
         return int(self.boundary_nodes[self.tree.query(p)[1]])
 
 
-def _rotate_to(theta: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """Branch of the cross (angle theta + k·90°) nearest to the direction d."""
-    a = np.arctan2(d[:, 1], d[:, 0])
-    k = np.rint((a - theta) / (np.pi / 2))
-    phi = theta + k * (np.pi / 2)
-    return np.column_stack([np.cos(phi), np.sin(phi)])
-
-
 def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) -> tuple:
     """Every separatrix and concave-corner streamline, one line per separatrix."""
     walker = mesh.walker
-    sources = _sources(mesh, field_, walker, mesh.element_size)
+    sources = separatrix_sources(mesh, field_, walker, mesh.element_size)
     if not sources:
         return ()
     lines = integrate(domain, mesh, field_, sources, walker)
-    return tuple(_one_line_per_separatrix(lines, mesh.element_size))
+    return tuple(one_line_per_separatrix(lines, mesh.element_size))
 
 
 def integrate(domain, mesh, field_, sources, walker=None) -> list:
@@ -120,7 +117,7 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
     tri0 = np.array([s[2] for s in sources])
     origin = [s[3] for s in sources]
 
-    targets, target_kind = _snap_targets(mesh, field_)
+    targets, target_kind = snap_targets(mesh, field_)
     max_steps = int(MAX_LENGTH * domain.size / step) + 2
 
     pos = starts + step * dirs
@@ -135,8 +132,7 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
                            boundary, h)
 
     def direction(t, b, d):
-        zc = (z[mesh.triangles[t]] * b).sum(axis=1)
-        return _rotate_to(np.angle(zc) / 4.0, d), np.abs(zc)
+        return nearest_arm(cross_angle(z, mesh.triangles, t, b), d)
 
     cur_dir = dirs.copy()
     prev = starts.copy()
@@ -144,13 +140,13 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
         if not len(active):
             break
         p = pos[active]
-        d1, _ = direction(tri[active], bary[active], cur_dir[active])
+        d1 = direction(tri[active], bary[active], cur_dir[active])
         mid = p + 0.5 * step * d1
         tm, bm, _ = walker.locate(tri[active], mid)
         d2 = d1.copy()
         ok = tm >= 0
         if ok.any():
-            d2[ok], _ = direction(tm[ok], bm[ok], d1[ok])
+            d2[ok] = direction(tm[ok], bm[ok], d1[ok])
         new = p + step * d2
         tn, bn, en = walker.locate(tri[active], new)
         tri[active], bary[active], exit_edge[active] = tn, bn, en
@@ -177,40 +173,6 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
         capped[i] = True
     return [Streamline(points=np.array(paths[i]), start=origin[i], end=ends[i],
                        capped=capped[i], start_direction=dirs[i]) for i in range(len(sources))]
-
-
-def _sources(mesh, field_, walker, h):
-    out = []
-    for si, sing in enumerate(field_.singularities):
-        for k, d in enumerate(sing.directions):
-            out.append((sing.xy, d, sing.triangle, Endpoint("singularity", si, branch=k)))
-    incident = {}
-    for t, tri in enumerate(mesh.triangles):
-        for n in tri:
-            incident.setdefault(int(n), []).append(t)
-    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
-    for cs in field_.corner_sources:
-        k = position[cs.node]
-        corner = Endpoint("corner", cs.node, int(mesh.boundary_loop[k]),
-                          int(mesh.boundary_segment[k]), 0.0)
-        for branch, d in enumerate(cs.directions):
-            probe = cs.xy + 1e-6 * h * d
-            tris = np.array(incident[cs.node])
-            b = walker.barycentric(tris, np.repeat(probe[None], len(tris), axis=0))
-            t0 = int(tris[np.argmax(b.min(axis=1))])
-            out.append((cs.xy, d, t0, Endpoint(corner.kind, corner.index, corner.loop,
-                                               corner.segment, 0.0, branch)))
-    return out
-
-
-def _snap_targets(mesh, field_):
-    xy = [s.xy for s in field_.singularities] + [c.xy for c in field_.corner_sources]
-    kind = [Endpoint("singularity", i) for i in range(len(field_.singularities))]
-    for c in field_.corner_sources:
-        k = int(np.nonzero(mesh.boundary_nodes == c.node)[0][0])
-        kind.append(Endpoint("corner", c.node, int(mesh.boundary_loop[k]),
-                             int(mesh.boundary_segment[k]), 0.0))
-    return np.array(xy).reshape(-1, 2), kind
 
 
 def _finish_exits(active, tri, exit_edge, old, pos, paths, ends, mesh, boundary, h):
@@ -252,11 +214,8 @@ def _segment_param(p0, p1, a, b) -> float:
 
 def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, field_,
                   paths, ends, h):
-    """End streamlines that reach a singular point or a concave corner.
-
-    Only a streamline that is closing in on the target snaps: one leaving a singular point
-    that happens to sit next to another must not end on it at once.
-    """
+    """End streamlines that reach a singular point or a concave corner (field_rules:
+    may_snap, and a singular point only along one of its separatrices)."""
     if not len(active) or not len(targets):
         return active
     p = pos[active]
@@ -267,20 +226,18 @@ def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, fi
     for k, i in enumerate(active):
         order = np.argsort(dist[k])
         done = False
-        for j in order[:3]:
+        for j in order[:SNAP_CANDIDATES]:
             if dist[k, j] > SNAP * h:
                 break
-            if dist[k, j] >= before[k, j]:
-                continue
             target = target_kind[j]
-            if target.same_place(origin[i]) and (target.kind == "corner"
-                                                 or travelled[i] < 3 * SNAP * h):
+            if not may_snap(dist[k, j], before[k, j], target.same_place(origin[i]),
+                            target.kind == "corner", travelled[i], h):
                 continue
             if target.kind == "singularity":
                 radial = (p[k] - targets[j]) / max(dist[k, j], 1e-300)
                 seps = field_.singularities[target.index].directions
                 alignment = seps @ radial
-                if np.max(alignment) < math.cos(SNAP_ANGLE):
+                if not arrives_along(np.max(alignment)):
                     continue
                 target = Endpoint("singularity", target.index, branch=int(np.argmax(alignment)))
             paths[i][-1] = targets[j].copy()
@@ -290,111 +247,3 @@ def _finish_snaps(active, pos, prev, travelled, origin, targets, target_kind, fi
         if not done:
             keep.append(i)
     return np.array(keep, dtype=np.int64)
-
-
-def _one_line_per_separatrix(lines, h):
-    """One streamline per separatrix.
-
-    A streamline from singular point a that arrives at b along b's separatrix k *is* that
-    separatrix of b, so b's own trace of k (which may have wandered elsewhere: tracing
-    leaves a singular point less reliably than it arrives) must go.  Each line claims the
-    separatrix slots at its two ends; shorter lines claim first, as a short connection
-    between two singular points is the most trustworthy trace.  A line whose start slot
-    is still free but whose end slot is taken still has to stay (its own separatrix would
-    be missing otherwise): it joins the line holding that slot where it meets it, as a
-    T-junction, instead of piling a second line onto the same separatrix.
-    """
-    def slot(e):
-        return (e.kind, e.index, e.branch) if e.branch >= 0 else None
-
-    lines = _arrival_branches(lines, h)
-    order = sorted(range(len(lines)), key=lambda i: lines[i].length)
-    owner, keep, joins = {}, set(), {}
-    for i in order:
-        mine = {slot(lines[i].start), slot(lines[i].end)} - {None}
-        if not any(m in owner for m in mine):
-            keep.add(i)
-            owner.update({m: i for m in mine})
-    for i in order:
-        start, end = slot(lines[i].start), slot(lines[i].end)
-        if i in keep:
-            continue
-        if start is not None and start not in owner:
-            keep.add(i)
-            owner[start] = i
-            if end is not None and end in owner:
-                joins[i] = owner[end]
-    final = sorted(keep)
-    position = {i: k for k, i in enumerate(final)}
-    out = []
-    for i in final:
-        line = lines[i]
-        if i in joins:
-            line = _join(line, lines[joins[i]], position[joins[i]], h)
-        out.append(line)
-    return out
-
-
-def _arrival_branches(lines, h):
-    """Which separatrix of its end point (singular point or concave corner) each arriving
-    streamline runs along.
-
-    The direction of arrival alone is ambiguous next to a singular point (the field turns
-    fast there), so compare the arriving line with the point's own traced separatrices
-    over the first few element sizes: it arrives along the one it lies closest to.
-    """
-    leaving = {(ln.start.kind, ln.start.index, ln.start.branch): ln for ln in lines}
-    out = []
-    for line in lines:
-        end = line.end
-        if not any(key[:2] == (end.kind, end.index) for key in leaving):
-            out.append(line)  # the boundary, or a convex corner: no separatrices there
-            continue
-        tree = cKDTree(_densify(line.points, 0.25 * h))
-        best, best_dist = end.branch, np.inf
-        for (kind, index, branch), own in leaving.items():
-            if (kind, index) != (end.kind, end.index):
-                continue
-            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= 3 * h]
-            if len(near) < 2:
-                continue
-            d = float(tree.query(near[1:])[0].mean())
-            if d < best_dist:
-                best, best_dist = branch, d
-        out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
-    return out
-
-
-def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
-    """End ``line`` on ``other`` where it first comes within MERGE sizes of it."""
-    dense = _densify(other.points, 0.25 * h)
-    dist = cKDTree(dense).query(line.points)[0]
-    close = np.nonzero(dist <= MERGE * h)[0]
-    close = close[close > 0]
-    if not len(close):
-        return line
-    head = int(close[0])
-    point, param = _nearest_on_polyline(other.points, line.points[head])
-    return dataclasses.replace(line, points=np.vstack([line.points[:head], point]),
-                               end=Endpoint("streamline", other_index, param=param))
-
-
-def _densify(points, spacing):
-    seg = np.diff(points, axis=0)
-    n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / spacing).astype(int))
-    parts = [points[i] + np.outer(np.arange(k) / k, seg[i]) for i, k in enumerate(n)]
-    return np.vstack(parts + [points[-1:]])
-
-
-def _nearest_on_polyline(points, p):
-    """Closest point to p on the polyline, and its arc-length fraction along it."""
-    a, b = points[:-1], points[1:]
-    d = b - a
-    len2 = np.maximum((d * d).sum(axis=1), 1e-300)
-    t = np.clip(((p - a) * d).sum(axis=1) / len2, 0.0, 1.0)
-    q = a + t[:, None] * d
-    k = int(np.argmin(np.hypot(*(q - p).T)))
-    seglen = np.sqrt(len2)
-    total = float(seglen.sum())
-    along = float(seglen[:k].sum() + t[k] * seglen[k])
-    return q[k], along / total if total > 0 else 0.0
