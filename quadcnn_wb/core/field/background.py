@@ -19,7 +19,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..gmsh_session import gmsh_session
-from ..input.curves import Arc, cross2
+from ..input.corners import interior_angle, is_corner
+from ..input.curves import Arc
 from ..input.domain import Domain
 from ..input.pose import KEY_DIGITS, Pose, canonical_pose
 
@@ -27,7 +28,6 @@ NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
 #                  whole edges gain a node at once and the count moves in steps of ~20
 MAX_SIZE_ITERATIONS = 12
-CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not corners
 GMSH_ALGORITHM = 6  # Frontal-Delaunay: near-equilateral triangles, no smoothing needed
 GMSH_DENSITY = 1.045  # gmsh's frontal meshes hold this many times the ideal node count
 
@@ -315,8 +315,8 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
             params.extend(t)
             tangents.extend(np.atleast_2d(curve.tangent(t)))
             if len(loop) > 1 or not getattr(curve, "is_full", False):
-                angle = _interior_angle(loop[si - 1], curve)
-                if abs(angle - math.pi) > CORNER_MIN_TURN:
+                angle = interior_angle(loop[si - 1], curve)
+                if is_corner(angle):
                     corner_nodes.append(int(ids[0]))
                     corner_angles.append(angle)
                     corner_in.append(loop[si - 1].tangent(1.0))
@@ -331,13 +331,6 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
         corner_angles=np.array(corner_angles, dtype=float),
         corner_tangents_in=np.array(corner_in, dtype=float).reshape(-1, 2),
         element_size=float(h))
-
-
-def _interior_angle(incoming, outgoing) -> float:
-    """Angle on the domain's side (the left) between consecutive curves at their joint."""
-    t_in, t_out = incoming.tangent(1.0), outgoing.tangent(0.0)
-    turn = math.atan2(cross2(t_in, t_out), float(np.dot(t_in, t_out)))
-    return math.pi - turn
 
 
 def _counter_clockwise(coords, triangles):
