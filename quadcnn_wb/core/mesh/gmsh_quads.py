@@ -18,7 +18,7 @@ import time
 import gmsh
 import numpy as np
 
-from ..field.background import _build_geometry
+from ..gmsh_geometry import build_geometry
 from ..gmsh_session import gmsh_session, silenced_stdio
 from ..input.pose import Pose, canonical_pose
 from .quadmesh import QuadMesh, _counter_clockwise
@@ -47,7 +47,7 @@ def gmsh_quasi_structured(domain, size: float):
     given, at gmsh mesh size ``size`` (elements of about size / 2): the peer of the
     benchmarks, timed on gmsh's meshing call alone."""
     with gmsh_session() as session:
-        _build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
+        build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
         for name, value in _quasi_structured_options(size):
             session.set(name, value)
         start = time.perf_counter()
@@ -77,7 +77,7 @@ def _recombined_options(size: float) -> tuple:
 
 def _gmsh_mesh(domain, pose, options) -> QuadMesh:
     with gmsh_session() as session:
-        curve_tags = _build_geometry(domain, pose)
+        curve_tags = build_geometry(domain, pose)
         for name, value in options:
             session.set(name, value)
         with silenced_stdio():
