@@ -21,7 +21,8 @@ import numpy as np
 from ..gmsh_geometry import build_geometry
 from ..gmsh_session import gmsh_session, silenced_stdio
 from ..input.pose import Pose, canonical_pose
-from .quadmesh import QuadMesh, _counter_clockwise
+from .orientation import counter_clockwise_quads
+from .quadmesh import QuadMesh
 from .quality import min_scaled_jacobian
 
 QUASI_STRUCTURED = 11  # gmsh's Mesh.Algorithm for quasi-structured quads
@@ -98,7 +99,7 @@ def _gmsh_mesh(domain, pose, options) -> QuadMesh:
     remap = np.full(len(nodes), -1)
     remap[used] = np.arange(len(used))
     nodes, boundary, quads = nodes[used], boundary[used], remap[quads]
-    quads = _counter_clockwise(nodes, quads)
+    quads = counter_clockwise_quads(nodes, quads)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=np.full(len(quads), -1),
                     boundary=boundary, edge_nodes=())
 
