@@ -70,10 +70,10 @@ def _source_or_mesh_source():
     """The selected sketch/face, or the source of a selected QuadCNN mesh."""
     meshes = _selected_meshes()
     if meshes:
-        from .mesh_object import _source_of
+        from .mesh_object import source_of
 
         try:
-            return _source_of(meshes[0])
+            return source_of(meshes[0])
         except ValueError:
             return None
     return _selected_source()
