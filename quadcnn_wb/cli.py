@@ -15,7 +15,7 @@ from .core.atomic import write_json_atomic
 from .core.field.background import BackgroundMeshError, background_mesh
 from .core.field.framefield import FieldError
 from .core.input.domain import DomainError, load_domain
-from .core.layout.partition import PartitionError
+from .core.layout.partition_types import PartitionError
 from .infer.predictor import ModelError
 
 

@@ -18,7 +18,8 @@ from .input.domain import Domain
 from .input.pose import diameter
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
-from .layout.partition import FreeFace, FreeFaceError, Partition, PartitionError, build_partition
+from .layout.partition import build_partition
+from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
 from .mesh.gmsh_quads import gmsh_quad_mesh

@@ -34,7 +34,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 from scipy.sparse import coo_matrix, lil_matrix
 
 from .collapse import conflicts, merges, node_layout
-from .partition import Partition, PartitionError
+from .partition_types import Partition, PartitionError
 
 
 def side_counts(partition: Partition, counts) -> list:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
-from ..layout.partition import FreeFaceError, Partition, PartitionError
+from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_quads
 from .orientation import counter_clockwise_quads as _counter_clockwise  # the body's name
 
