@@ -14,7 +14,8 @@ from pathlib import Path
 from .core.atomic import write_json_atomic
 from .core.field.background import BackgroundMeshError, background_mesh
 from .core.field.framefield import FieldError
-from .core.input.domain import DomainError, load_domain
+from .core.input.domain import DomainError
+from .core.input.load import load_domain
 from .core.layout.partition_types import PartitionError
 from .infer.predictor import ModelError
 

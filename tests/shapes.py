@@ -56,7 +56,8 @@ def named_domain(name):
     """A shared example (by file stem) or one of OWN_SHAPES, as a Domain."""
     from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
 
-    from quadcnn_wb.core.input.domain import domain_from_json, load_domain
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.load import load_domain
 
     if name in EXAMPLE_NAMES:
         return load_domain(SHARED_EXAMPLES / f"{name}.json")

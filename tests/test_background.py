@@ -11,7 +11,8 @@ from conftest import circle, rect
 
 from quadcnn_wb.core.field.background import background_mesh
 from quadcnn_wb.core.input.curves import winding_number, winding_numbers
-from quadcnn_wb.core.input.domain import domain_from_json, load_domain
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.load import load_domain
 
 EXPECTED_CORNERS = {  # interior angles in degrees, sorted
     "concave": [90] * 6 + [270] * 2,

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from quadcnn_wb.core.input.domain import DomainError, load_domain
+from quadcnn_wb.core.input.domain import DomainError
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.pipeline import free_edges_on_boundary, mesh_domain, tiles_exactly
 
 CORPUS = Path(__file__).parent / "corpus"

@@ -14,7 +14,7 @@ from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
 from shapes import OWN_SHAPES, named_domain
 
 from quadcnn_wb.bench.meshcheck import check_quad_mesh
-from quadcnn_wb.core.input.domain import load_domain
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.quantize import side_counts
 from quadcnn_wb.core.pipeline import mesh_domain
 

@@ -12,7 +12,7 @@ from conftest import SHARED_EXAMPLES
 from scipy.spatial import cKDTree
 
 from quadcnn_wb.core.field.reference import numerical_reference
-from quadcnn_wb.core.input.domain import load_domain
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.partition import build_partition
 from quadcnn_wb.infer.reconstruct import reconstruct_streamlines
 

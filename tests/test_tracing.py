@@ -12,7 +12,7 @@ from shapes import OWN_SHAPES, named_domain
 
 from quadcnn_wb.core.field.labels import resample
 from quadcnn_wb.core.field.reference import numerical_reference
-from quadcnn_wb.core.input.domain import load_domain
+from quadcnn_wb.core.input.load import load_domain
 
 CASES = EXAMPLE_NAMES + list(OWN_SHAPES)
 

@@ -22,7 +22,8 @@ import statistics
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..core.input.domain import DomainError, load_domain
+from ..core.input.domain import DomainError
+from ..core.input.load import load_domain
 from ..core.input.pose import diameter
 from ..core.pipeline import default_size, mesh_domain
 from .mesh_vs_gmsh import gmsh_quasi_structured, score

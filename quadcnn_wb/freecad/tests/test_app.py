@@ -30,7 +30,7 @@ class TestQuadCNNApp(unittest.TestCase):
 
     def test_background_mesh_runs_in_freecad(self):
         from quadcnn_wb.core.field.background import background_mesh
-        from quadcnn_wb.core.input.domain import load_domain
+        from quadcnn_wb.core.input.load import load_domain
 
         domain = load_domain(environment.resource_path("examples", "plate_hole.json"))
         mesh = background_mesh(domain, nodes=1000)
