@@ -12,10 +12,11 @@ import sys
 from pathlib import Path
 
 from .core.atomic import write_json_atomic
-from .core.background import BackgroundMeshError, background_mesh
-from .core.domain import DomainError, load_domain
-from .core.framefield import FieldError
-from .core.partition import PartitionError
+from .core.field.background import BackgroundMeshError, background_mesh
+from .core.field.framefield import FieldError
+from .core.input.domain import DomainError
+from .core.input.load import load_domain
+from .core.layout.partition_types import PartitionError
 from .infer.predictor import ModelError
 
 
@@ -165,7 +166,7 @@ def _run_background(args) -> None:
 
 
 def _run_field(args) -> None:
-    from .core.reference import numerical_reference
+    from .core.field.reference import numerical_reference
 
     out = _check_output(args.output, {".json"})
     png = _check_output(args.png, {".png"})
@@ -199,7 +200,7 @@ def _streamline_source(args, domain):
 
 
 def _run_mesh(args) -> None:
-    from .core.export import FORMATS, export
+    from .core.mesh.export import FORMATS, export
     from .core.pipeline import mesh_domain
 
     out = _check_output(args.output, FORMATS)

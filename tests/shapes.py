@@ -31,8 +31,8 @@ def stadium():
             {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]
 
 
-from quadcnn_wb.core.transform import similarity as rotation  # noqa: E402,F401
-from quadcnn_wb.core.transform import transform_domain_json as transform_domain  # noqa: E402,F401
+from quadcnn_wb.core.input.transform import similarity as rotation  # noqa: E402,F401
+from quadcnn_wb.core.input.transform import transform_domain_json as transform_domain  # noqa: E402,F401
 
 # name -> (loops, expected valence-3 count, expected valence-5 count)
 OWN_SHAPES = {
@@ -56,7 +56,8 @@ def named_domain(name):
     """A shared example (by file stem) or one of OWN_SHAPES, as a Domain."""
     from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
 
-    from quadcnn_wb.core.domain import domain_from_json, load_domain
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.load import load_domain
 
     if name in EXAMPLE_NAMES:
         return load_domain(SHARED_EXAMPLES / f"{name}.json")

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from conftest import circle, rect
 
-from quadcnn_wb.core.background import background_mesh
-from quadcnn_wb.core.curves import winding_number, winding_numbers
-from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.field.background import background_mesh
+from quadcnn_wb.core.input.curves import winding_number, winding_numbers
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.load import load_domain
 
 EXPECTED_CORNERS = {  # interior angles in degrees, sorted
     "concave": [90] * 6 + [270] * 2,

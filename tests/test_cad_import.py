@@ -8,9 +8,10 @@ import gmsh
 import numpy as np
 import pytest
 
-from quadcnn_wb.core.background import background_mesh
-from quadcnn_wb.core.domain import DomainError, load_domain
+from quadcnn_wb.core.field.background import background_mesh
 from quadcnn_wb.core.gmsh_session import gmsh_session, silenced_stdio
+from quadcnn_wb.core.input.domain import DomainError
+from quadcnn_wb.core.input.load import load_domain
 
 PLATE_AREA = 2.0 - math.pi * 0.25**2
 

@@ -12,7 +12,7 @@ import torch
 from conftest import SHARED_EXAMPLES, run_cli
 
 from quadcnn_wb.bench.meshcheck import check_quad_mesh
-from quadcnn_wb.core.domain import load_domain
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.pipeline import mesh_domain
 from quadcnn_wb.infer.cnn import cnn_streamlines
 from quadcnn_wb.infer.predictor import ModelError

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from quadcnn_wb.core.domain import DomainError, load_domain
+from quadcnn_wb.core.input.domain import DomainError
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.pipeline import free_edges_on_boundary, mesh_domain, tiles_exactly
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -104,8 +105,8 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 def test_a_part_with_free_faces_gets_the_same_mesh_in_every_pose():
     import numpy as np
 
-    from quadcnn_wb.core.domain import domain_from_json
-    from quadcnn_wb.core.transform import similarity, transform_domain_json
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 
     data = load_domain(CORPUS / PARTS["housing_rib"]["file"]).to_json()
     base = mesh_domain(domain_from_json(data))

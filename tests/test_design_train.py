@@ -10,7 +10,7 @@ import sys
 
 from conftest import REPO
 
-from quadcnn_wb.core.transform import similarity, transform_domain_json
+from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 from quadcnn_wb.infer.predictor import Predictor
 from quadcnn_wb.learn.families import family
 

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from conftest import circle, rect
 
-from quadcnn_wb.core.curves import Arc, loop_signed_area
-from quadcnn_wb.core.domain import domain_from_json, load_domain
+from quadcnn_wb.core.input.curves import Arc, loop_signed_area
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.load import load_domain
 
 EXPECTED_AREA = {
     "concave": 2.0 - 0.6 * 0.5,

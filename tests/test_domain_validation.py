@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 from conftest import circle, rect
 
-from quadcnn_wb.core.domain import DomainError, domain_from_json, load_domain
+from quadcnn_wb.core.input.domain import DomainError, domain_from_json
+from quadcnn_wb.core.input.load import load_domain
 
 L = lambda a, b: {"line": [a, b]}  # noqa: E731
 

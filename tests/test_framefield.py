@@ -10,9 +10,10 @@ import pytest
 from conftest import SHARED_EXAMPLES
 from shapes import OWN_SHAPES, rotation, transform_domain
 
-from quadcnn_wb.core.background import background_mesh
-from quadcnn_wb.core.domain import domain_from_json, load_domain
-from quadcnn_wb.core.framefield import compute_frame_field
+from quadcnn_wb.core.field.background import background_mesh
+from quadcnn_wb.core.field.framefield import compute_frame_field
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.load import load_domain
 
 EXPECTED = json.loads((SHARED_EXAMPLES / "expected_singularities.json").read_text())
 

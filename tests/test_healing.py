@@ -8,8 +8,8 @@ import math
 import pytest
 from conftest import rect, run_cli
 
-from quadcnn_wb.core.domain import DomainError, domain_from_json
-from quadcnn_wb.core.healing import HEAL_TOL
+from quadcnn_wb.core.input.domain import DomainError, domain_from_json
+from quadcnn_wb.core.input.healing import HEAL_TOL
 from quadcnn_wb.core.pipeline import mesh_domain
 
 L = lambda a, b: {"line": [a, b]}  # noqa: E731

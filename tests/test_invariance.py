@@ -12,9 +12,9 @@ import sys
 import numpy as np
 import pytest
 
-from quadcnn_wb.core.domain import domain_from_json
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 from quadcnn_wb.core.pipeline import mesh_domain
-from quadcnn_wb.core.transform import similarity, transform_domain_json
 from quadcnn_wb.learn.families import FAMILIES, family
 
 POSES = {  # (degrees, mirror, scale, shift in part sizes)

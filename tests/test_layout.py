@@ -55,3 +55,18 @@ def test_readme_starts_with_the_two_commands():
     text = (REPO / "README.md").read_text()
     first_block = text[: text.index("make test") + 20]
     assert "make demo" in first_block and len(first_block) < 1500
+
+
+def test_infer_never_imports_the_freecad_side():
+    """FreeCAD hands infer its model folder (infer.user_folder), not the other way."""
+    packages = {0: "", 1: "quadcnn_wb.infer.", 2: "quadcnn_wb."}
+    for path in (REPO / "quadcnn_wb" / "infer").rglob("*.py"):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                names = [packages[node.level] + (node.module or "")]
+            elif isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            else:
+                continue
+            assert not any(n.startswith("quadcnn_wb.freecad") for n in names), path.name

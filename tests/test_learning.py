@@ -11,8 +11,8 @@ import pytest
 import torch
 from conftest import run_cli
 
-from quadcnn_wb.core.partition import build_partition
-from quadcnn_wb.core.reference import numerical_reference
+from quadcnn_wb.core.field.reference import numerical_reference
+from quadcnn_wb.core.layout.partition import build_partition
 from quadcnn_wb.infer.encoding import canonical_angle, encode, swap_labels
 from quadcnn_wb.infer.predictor import ModelError, Predictor
 from quadcnn_wb.learn.dataset import generate, load_dataset, make_sample, save_dataset
@@ -263,8 +263,8 @@ def test_families_and_dataset_commands(tmp_path):
 
 
 def test_topology_signatures_ignore_rotation_mirroring_and_order():
-    from quadcnn_wb.core.domain import domain_from_json
-    from quadcnn_wb.core.transform import similarity, transform_domain_json
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.transform import similarity, transform_domain_json
     from quadcnn_wb.infer.signature import topology_signature
 
     rng = np.random.default_rng(4)

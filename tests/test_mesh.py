@@ -14,7 +14,7 @@ from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
 from shapes import OWN_SHAPES, named_domain
 
 from quadcnn_wb.bench.meshcheck import check_quad_mesh
-from quadcnn_wb.core.domain import load_domain
+from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.quantize import side_counts
 from quadcnn_wb.core.pipeline import mesh_domain
 
@@ -90,7 +90,7 @@ def test_annulus_gets_a_cut_and_meshes():
 
 def test_mesh_exports_read_back(tmp_path):
     result = meshed("plate_hole")
-    from quadcnn_wb.core.export import export
+    from quadcnn_wb.core.mesh.export import export
 
     for suffix in (".msh", ".vtk"):
         export(result, tmp_path / f"m{suffix}")
@@ -135,7 +135,7 @@ def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
 
 
 def test_faces_that_are_not_blocks_get_conforming_unstructured_quads():
-    from quadcnn_wb.core.partition import build_partition
+    from quadcnn_wb.core.layout.partition import build_partition
     from quadcnn_wb.core.pipeline import blocks_and_mesh, free_edges_on_boundary, tiles_exactly
 
     result = meshed("plate_hole")
@@ -174,7 +174,7 @@ def test_three_cornered_faces_are_split_into_blocks():
     # midpoint subdivision turns into three blocks around one extra valence-3 vertex.
     from shapes import polygon
 
-    from quadcnn_wb.core.domain import domain_from_json
+    from quadcnn_wb.core.input.domain import domain_from_json
 
     domain = domain_from_json({"loops": [polygon([[0, 0], [3, 0], [0, 1.2]])]})
     result = mesh_domain(domain)

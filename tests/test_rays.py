@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 from conftest import SHARED_EXAMPLES
 
-from quadcnn_wb.core.domain import domain_from_json, load_domain
-from quadcnn_wb.core.reference import numerical_reference
-from quadcnn_wb.core.transform import similarity, transform_domain_json
+from quadcnn_wb.core.field.reference import numerical_reference
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.load import load_domain
+from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 from quadcnn_wb.infer.encoding import model_input, swap_labels
 from quadcnn_wb.infer.metrics import Confusion
 from quadcnn_wb.infer.rays import (

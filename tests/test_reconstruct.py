@@ -11,9 +11,9 @@ import pytest
 from conftest import SHARED_EXAMPLES
 from scipy.spatial import cKDTree
 
-from quadcnn_wb.core.domain import load_domain
-from quadcnn_wb.core.partition import build_partition
-from quadcnn_wb.core.reference import numerical_reference
+from quadcnn_wb.core.field.reference import numerical_reference
+from quadcnn_wb.core.input.load import load_domain
+from quadcnn_wb.core.layout.partition import build_partition
 from quadcnn_wb.infer.reconstruct import reconstruct_streamlines
 
 
@@ -63,7 +63,7 @@ def test_useless_labels_fall_back_to_tracing():
 def test_a_line_across_the_field_is_not_trusted():
     """The verification that catches a walk gone over to a neighbouring band: traced
     streamlines pass it, a line cutting across the crosses does not."""
-    from quadcnn_wb.core.tracing import Endpoint, Streamline
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
     from quadcnn_wb.infer.rays import CrossField
     from quadcnn_wb.infer.reconstruct import _stray
 

@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from quadcnn_wb.bench.robustness import NEVER, campaign, report, run_one
-from quadcnn_wb.core.domain import domain_from_json
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.pose import area_centroid
+from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 from quadcnn_wb.core.pipeline import mesh_domain
-from quadcnn_wb.core.pose import area_centroid
-from quadcnn_wb.core.transform import similarity, transform_domain_json
 
 POSES = {
     "moved": (similarity(0.0), (123.25, -77.5)),

@@ -10,9 +10,9 @@ import pytest
 from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES
 from shapes import OWN_SHAPES, named_domain
 
-from quadcnn_wb.core.domain import load_domain
-from quadcnn_wb.core.labels import resample
-from quadcnn_wb.core.reference import numerical_reference
+from quadcnn_wb.core.field.labels import resample
+from quadcnn_wb.core.field.reference import numerical_reference
+from quadcnn_wb.core.input.load import load_domain
 
 CASES = EXAMPLE_NAMES + list(OWN_SHAPES)
 
@@ -132,9 +132,9 @@ def _distance_to_polyline(p, points):
 
 
 def test_streamlines_that_run_too_long_are_capped_onto_the_boundary(monkeypatch):
-    from quadcnn_wb.core import tracing
-    from quadcnn_wb.core.background import background_mesh
-    from quadcnn_wb.core.framefield import compute_frame_field
+    from quadcnn_wb.core.field.background import background_mesh
+    from quadcnn_wb.core.field.framefield import compute_frame_field
+    from quadcnn_wb.core.layout import tracing
 
     domain = load_domain(SHARED_EXAMPLES / "plate_hole.json")
     mesh = background_mesh(domain)

@@ -13,15 +13,16 @@ import time
 
 import gmsh
 
-from ..core.background import GMSH_ALGORITHM, _build_geometry, background_mesh
+from ..core.field.background import GMSH_ALGORITHM, background_mesh
+from ..core.gmsh_geometry import build_geometry
 from ..core.gmsh_session import gmsh_session
-from ..core.pose import canonical_pose
+from ..core.input.pose import canonical_pose
 from .common import bundled_examples, parse_options
 
 
 def bare_gmsh_seconds(domain, h: float) -> float:
     with gmsh_session() as session:
-        _build_geometry(domain, canonical_pose(domain))
+        build_geometry(domain, canonical_pose(domain))
         for name, value in (("Mesh.Algorithm", GMSH_ALGORITHM), ("Mesh.MeshSizeFromPoints", 0),
                             ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.Smoothing", 0),
                             ("Mesh.MeshSizeMin", h), ("Mesh.MeshSizeMax", h)):

@@ -30,11 +30,11 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.distance import directed_hausdorff
 
-from ..core.domain import domain_from_json
-from ..core.labels import frame_labels
+from ..core.field.labels import frame_labels
+from ..core.input.domain import domain_from_json
+from ..core.input.transform import similarity, transform_domain_json
+from ..core.layout.tracing import trace_streamlines
 from ..core.pipeline import mesh_domain
-from ..core.tracing import trace_streamlines
-from ..core.transform import similarity, transform_domain_json
 from ..infer.cnn import cnn_streamlines
 from ..infer.encoding import model_input, swap_labels
 from ..infer.models import model_paths

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..core.domain import load_domain
+from ..core.input.load import load_domain
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 

@@ -22,9 +22,10 @@ import statistics
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..core.domain import DomainError, load_domain
+from ..core.input.domain import DomainError
+from ..core.input.load import load_domain
+from ..core.input.pose import diameter
 from ..core.pipeline import default_size, mesh_domain
-from ..core.pose import diameter
 from .mesh_vs_gmsh import gmsh_quasi_structured, score
 
 CORPUS = Path(__file__).resolve().parents[2] / "tests" / "corpus"

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import statistics
 
-from ..core.background import background_mesh
-from ..core.reference import numerical_reference
+from ..core.field.background import background_mesh
+from ..core.field.reference import numerical_reference
 from .common import bundled_examples, parse_options
 
 PAPER_TRACING_SECONDS = 1.644

@@ -14,8 +14,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..core.domain import load_domain
-from ..core.reference import numerical_reference
+from ..core.field.reference import numerical_reference
+from ..core.input.load import load_domain
 from ..infer.encoding import model_input
 from ..infer.models import model_paths
 from ..infer.predictor import INPUT_WIDTHS, Predictor

@@ -12,10 +12,10 @@ from __future__ import annotations
 import argparse
 import statistics
 
-from ..core.gmsh_quads import gmsh_quasi_structured
+from ..core.mesh.gmsh_quads import gmsh_quasi_structured
+from ..core.mesh.quadmesh import scaled_jacobians
+from ..core.mesh.quality import boundary_quads_expected, irregular_vertices
 from ..core.pipeline import DEFAULT_SIZE_DIVISOR, mesh_domain
-from ..core.quadmesh import scaled_jacobians
-from ..core.quality import boundary_quads_expected, irregular_vertices
 from .common import bundled_examples
 
 

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..core.transform import similarity, transform_domain_json
+from ..core.input.transform import similarity, transform_domain_json
 
 
 def _star_polygon(rng, corners: int) -> np.ndarray:

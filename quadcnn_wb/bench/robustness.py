@@ -26,7 +26,7 @@ NEVER = ("failed", "invalid mesh", "crash", "hang")
 
 def run_one(seed: int, index: int) -> dict:
     """Draw shape `index` of campaign `seed`, mesh it, check it; never raises."""
-    from ..core.domain import DomainError, domain_from_json
+    from ..core.input.domain import DomainError, domain_from_json
     from ..core.pipeline import mesh_domain
     from .meshcheck import MeshDefect, check_domain_mesh
     from .random_shapes import random_shape

@@ -13,17 +13,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .cuts import connecting_cuts
-from .domain import Domain
-from .gmsh_quads import gmsh_quad_mesh
+from .field.reference import Reference, background_and_field
+from .input.domain import Domain
+from .input.pose import diameter
+from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
+from .layout.partition import build_partition
+from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
 from .layout.quantize import quantize, quantize_freeing
-from .partition import FreeFace, FreeFaceError, Partition, PartitionError, build_partition
-from .pose import diameter
-from .quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
-from .quality import mesh_quality, structured_share
-from .reference import Reference, background_and_field
-from .tracing import trace_streamlines
+from .layout.tracing import trace_streamlines
+from .mesh.gmsh_quads import gmsh_quad_mesh
+from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
+from .mesh.quality import mesh_quality, structured_share
 
 DEFAULT_SIZE_DIVISOR = 40  # default element size: the part's diameter / this
 MIN_VALID_JACOBIAN = 0.05  # a block-structured mesh worse than this is not handed out

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.domain import domain_from_json
-from ..core.export import boundary_node_sets, write_inp
+from ..core.input.domain import domain_from_json
+from ..core.mesh.export import boundary_node_sets, write_inp
 from ..core.pipeline import mesh_domain
 
 

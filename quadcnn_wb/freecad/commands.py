@@ -70,10 +70,10 @@ def _source_or_mesh_source():
     """The selected sketch/face, or the source of a selected QuadCNN mesh."""
     meshes = _selected_meshes()
     if meshes:
-        from .mesh_object import _source_of
+        from .mesh_object import source_of
 
         try:
-            return _source_of(meshes[0])
+            return source_of(meshes[0])
         except ValueError:
             return None
     return _selected_source()
@@ -99,7 +99,7 @@ class ShowField:
         return FreeCAD.ActiveDocument is not None and _source_or_mesh_source() is not None
 
     def Activated(self):
-        from ..core.domain import DomainError
+        from ..core.input.domain import DomainError
         from .field_view import toggle
         from .geometry import face_to_domain, source_shape_and_placement
         from .preferences import target_nodes
@@ -161,7 +161,7 @@ def export_mesh(mesh, path: str) -> None:
     """Our writers (with block and boundary sets) when the last result is in memory."""
     result = getattr(mesh.Proxy, "last_result", None)
     if result is not None and not path.lower().endswith(".unv"):
-        from ..core.export import export
+        from ..core.mesh.export import export
 
         export(result, path)
     else:

@@ -13,7 +13,7 @@ import sys
 
 import FreeCAD
 
-from quadcnn_wb.core.export import write_inp
+from quadcnn_wb.core.mesh.export import write_inp
 from quadcnn_wb.freecad import make_quad_mesh
 from quadcnn_wb.freecad.environment import resource_path
 from quadcnn_wb.viz.mesh_plot import plot_mesh

@@ -47,7 +47,7 @@ def make_variants(sketch, count: int, spread: dict, seed: int = 0, report=None):
     their value.  A variant the solver cannot satisfy, whose profile breaks, or whose
     topology differs from the design's is skipped; report(done, total) after each try.
     """
-    from ..core.domain import DomainError
+    from ..core.input.domain import DomainError
     from ..infer.signature import topology_signature
 
     rng = np.random.default_rng(seed)

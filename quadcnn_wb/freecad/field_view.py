@@ -40,7 +40,7 @@ def labelled_segments(nodes, theta, labels, arm: float):
 
 def compute(domain, nodes: int = 2048):
     """(reference, labels or None, model entry or None) for the shape."""
-    from ..core.reference import numerical_reference
+    from ..core.field.reference import numerical_reference
     from ..infer.models import model_for
     from ..infer.predictor import Predictor
 

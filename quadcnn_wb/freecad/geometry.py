@@ -13,8 +13,8 @@ import FreeCAD
 import numpy as np
 import Part
 
-from ..core.curves import Arc, Line
-from ..core.domain import DomainError, make_domain
+from ..core.input.curves import Arc, Line
+from ..core.input.domain import DomainError, make_domain
 
 CURVE_TOLERANCE = 1e-4  # chordal deviation for curves that are not lines or arcs (x size)
 

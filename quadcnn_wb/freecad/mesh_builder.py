@@ -7,7 +7,7 @@ from __future__ import annotations
 import Fem
 import Part
 
-from ..core.export import boundary_node_sets
+from ..core.mesh.export import boundary_node_sets
 from .geometry import to_global
 
 

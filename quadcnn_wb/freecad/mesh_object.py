@@ -95,7 +95,7 @@ class QuadMeshProxy(Stateless):
             ViewProviderQuadMesh(obj.ViewObject)
 
     def execute(self, obj):
-        from ..core.domain import DomainError
+        from ..core.input.domain import DomainError
         from ..core.pipeline import mesh_domain
         from .geometry import face_to_domain, source_shape_and_placement, to_global
         from .mesh_builder import fem_mesh, update_companions
@@ -104,7 +104,7 @@ class QuadMeshProxy(Stateless):
         progress = FreeCAD.Base.ProgressIndicator()
         progress.start(f"QuadCNN: meshing {obj.Label}", 0)
         try:
-            source = _source_of(obj)
+            source = source_of(obj)
             face, plane, placement = source_shape_and_placement(source)
             label = source[0].Label if isinstance(source, tuple) else source.Label
             domain = face_to_domain(face, plane, label)
@@ -170,7 +170,10 @@ def _learned_source(obj, domain):
     return cnn_streamlines(entry.path, threads=preferences.threads())
 
 
-def _source_of(obj):
+def source_of(obj):
+    """What a mesh object meshes: the linked object, or (object, face name) when one face
+    of it is linked; ValueError when nothing is.  Public: the commands act on a selected
+    mesh's source too."""
     link = obj.Source
     if link is None or link[0] is None:
         raise ValueError("no source: link a sketch or a planar face")

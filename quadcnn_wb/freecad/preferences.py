@@ -6,6 +6,8 @@ by the preferences page, whose widgets store straight into these parameters.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import FreeCAD
 
 PARAMETERS = "User parameter:BaseApp/Preferences/Mod/QuadCNN"
@@ -31,6 +33,14 @@ def method() -> str:
 
 def model_folder() -> str:
     return _group().GetString("ModelFolder", "")
+
+
+def user_model_folder() -> Path:
+    """Where user models go inside FreeCAD: the folder chosen here, else FreeCAD's user
+    data folder's QuadCNN/models (registered with infer.user_folder at import of
+    quadcnn_wb.freecad; $QUADCNN_MODELS still overrides it)."""
+    chosen = model_folder()
+    return Path(chosen) if chosen else Path(FreeCAD.getUserAppDataDir()) / "QuadCNN" / "models"
 
 
 def threads() -> int:

@@ -131,7 +131,7 @@ class TrainingRun(QtCore.QObject):
 
     def install(self):
         """Save the model to the user folder and embed it in the design's meshes."""
-        from ..infer.models import user_model_folder
+        from ..infer.user_folder import user_model_folder
 
         folder = user_model_folder()
         folder.mkdir(parents=True, exist_ok=True)

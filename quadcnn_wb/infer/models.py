@@ -1,21 +1,21 @@
 """Where models live and which one fits a domain.
 
 Two folders are searched: the models shipped in `resources/models`, and a per-user folder
-(inside FreeCAD the folder set in the preferences, else FreeCAD's user data folder;
-`$XDG_DATA_HOME/QuadCNN/models` outside; `$QUADCNN_MODELS` overriding all) where
-trained-for-this-design models are saved.  A model fits a domain when the topology
+(user_folder.py: inside FreeCAD the folder set in the preferences, else FreeCAD's user
+data folder; `$XDG_DATA_HOME/QuadCNN/models` outside; `$QUADCNN_MODELS` overriding all)
+where trained-for-this-design models are saved.  A model fits a domain when the topology
 signature in its metadata equals the domain's; user models win over shipped ones, so a
 retrained model replaces the stock one for its topology without touching the installation.
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from .predictor import ModelError, load_metadata
 from .signature import topology_signature
+from .user_folder import user_model_folder
 
 SHIPPED_MODELS = Path(__file__).resolve().parents[2] / "resources" / "models"
 # `auto` only takes a model this good on its test split (foreground IoU): a weaker one
@@ -30,23 +30,6 @@ class ModelEntry:
     topology: str
     origin: str  # "user" or "shipped"
     test_iou: float = 0.0  # from its metadata (0 when not recorded)
-
-
-def user_model_folder() -> Path:
-    override = os.environ.get("QUADCNN_MODELS")
-    if override:
-        return Path(override)
-    try:
-        import FreeCAD  # present only inside FreeCAD
-
-        from ..freecad.preferences import model_folder
-
-        chosen = model_folder()
-        return Path(chosen) if chosen else Path(FreeCAD.getUserAppDataDir()) / "QuadCNN" / \
-            "models"
-    except ImportError:
-        base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
-        return Path(base) / "QuadCNN" / "models"
 
 
 def available_models(folders=None) -> list[ModelEntry]:

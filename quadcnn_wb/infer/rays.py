@@ -25,7 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-SOURCE_SNAP = 1.0  # a ray this close (in element sizes) to another source ends on it
+from ..core.layout.field_rules import SNAP, claim_separatrices, cross_angle
+
+SOURCE_SNAP = SNAP  # a ray this close (in element sizes) to another source ends on it
 CLIP = 4.0  # distances beyond this many element sizes all read as "far"
 FEATURES = ("ray distance v1", "ray distance v2", "boundary distance", "source distance",
             "ray label v1", "ray label v2")
@@ -142,8 +144,13 @@ def _march(rays, field, nodes, edges, boundary_tree, h, step=1.0):
 def one_ray_per_separatrix(rays: Rays, lines: list, ended_at: np.ndarray) -> list:
     """Indices of the rays to keep: a ray from source a that arrives at source b along
     b's separatrix k *is* that separatrix, so b's own ray along k goes (the tracer's
-    rule, core.tracing: shorter connections claim their two separatrices first).  Two
-    slightly different copies of one connection would widen its band of labels."""
+    rule, core.layout.field_rules.claim_separatrices: shorter connections claim their
+    two separatrices first).  Two slightly different copies of one connection would
+    widen its band of labels.  A ray's separatrix slot is the ray itself; the one it
+    arrives along is the arriving source's ray closest to the direction it came from
+    (a coarse ray is not compared with traced lines as the tracer does), and a ray
+    whose end slot is taken is not joined to anything: it is a hint, not a partition
+    edge."""
     length = np.array([np.hypot(*np.diff(p, axis=0).T).sum() for p in lines])
     arrival = np.full(len(lines), -1, dtype=np.int64)
     for i in np.nonzero(ended_at >= 0)[0]:
@@ -152,27 +159,19 @@ def one_ray_per_separatrix(rays: Rays, lines: list, ended_at: np.ndarray) -> lis
         before = lines[i][-2] if len(lines[i]) > 1 else lines[i][-1]
         radial = before - rays.sources[b]
         arrival[i] = own[np.argmax(rays.directions[own] @ radial)] if len(own) else -1
-    taken, keep = set(), []
-    order = np.argsort(length, kind="stable")
-    for i in order:
-        mine = {int(i)} | ({int(arrival[i])} if arrival[i] >= 0 else set())
-        if not mine & taken:
-            keep.append(int(i))
-            taken |= mine
-    for i in order:  # its own separatrix is not yet anyone's: it stays
-        if int(i) not in taken:
-            keep.append(int(i))
-            taken.add(int(i))
-    return sorted(keep)
+    keep, _ = claim_separatrices(length, list(range(len(lines))),
+                                 [int(a) if a >= 0 else None for a in arrival])
+    return keep
 
 
 class CrossField:
     """The cross field between the nodes: z = exp(4it) interpolated linearly in the
-    triangle holding a point (the tracer's interpolation), found by walking from the
-    triangle with the nearest centroid; points off the mesh take cross_angle_at."""
+    triangle holding a point (field_rules.cross_angle, as the tracer does), found by
+    walking from the triangle with the nearest centroid; points off the mesh take
+    cross_angle_at.  For callers that have points, not a walk that knows its triangle."""
 
     def __init__(self, nodes, triangles, theta, walker=None, centroids=None, tree=None):
-        from ..core.meshwalk import MeshWalker
+        from ..core.field.meshwalk import MeshWalker
 
         self.tree = tree if tree is not None else cKDTree(nodes)
         self.centroids = centroids if centroids is not None \
@@ -191,14 +190,17 @@ class CrossField:
         tri, bary, _ = self.walker.locate(self.centroids.query(points)[1], points)
         inside = tri >= 0
         out = np.empty(len(points))
-        out[inside] = np.angle((self.z[self.triangles[tri[inside]]] * bary[inside])
-                               .sum(axis=1)) / 4.0
+        out[inside] = cross_angle(self.z, self.triangles, tri[inside], bary[inside])
         if not inside.all():
             out[~inside] = cross_angle_at(self.tree, self.z, points[~inside])
         return out
 
     def arm(self, points, heading):
-        """The unit cross arm at each point closest to its heading."""
+        """The unit cross arm at each point closest to its heading.
+
+        The rule of field_rules.nearest_arm, found by comparing the four arms instead of
+        rounding the angle difference; the two can differ in the last bits, and the
+        shipped models were trained on hints marched this way, so it stays."""
         arms = self.angle(points)[:, None] + np.arange(4)[None] * (np.pi / 2)
         dots = np.cos(arms) * heading[:, 0:1] + np.sin(arms) * heading[:, 1:2]
         best = arms[np.arange(len(points)), np.argmax(dots, axis=1)]
@@ -220,7 +222,7 @@ def ray_features(nodes: np.ndarray, triangles: np.ndarray, theta: np.ndarray, ra
     the labels' own rule applied to the rays (1: a ray crosses a triangle of the node
     heading along that vector).  `field`: the cross field on these nodes, when the caller
     has one (CrossField.on a mesh shares its point location)."""
-    from ..core.labels import crossed_labels, resample
+    from ..core.field.labels import crossed_labels, resample
 
     out = np.ones((len(nodes), len(FEATURES)))
     out[:, 4:] = 0.0

@@ -30,8 +30,19 @@ import numpy as np
 from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
-from ..core.curves import winding_numbers
-from ..core.tracing import MAX_LENGTH, SNAP, SNAP_ANGLE, Endpoint, Streamline
+from ..core.input.curves import winding_numbers
+from ..core.layout.field_rules import (
+    MAX_LENGTH,
+    SNAP,
+    SNAP_CANDIDATES,
+    arrives_along,
+    may_snap,
+    one_line_per_separatrix,
+    separatrix_sources,
+    snap_targets,
+)
+from ..core.layout.streamlines import Endpoint, Streamline
+from ..core.layout.tracing import integrate
 from .rays import CrossField
 
 NEIGHBOURS = 12  # m of the paper
@@ -171,11 +182,12 @@ def walk_labels(domain, mesh, field, vectors: LabelledVectors, sources, boundary
 
 class _SnapTargets:
     """Where walks may end (singular points, source corners), as arrays, so every walk
-    under way is checked at once — by the rules of numerical tracing (core.tracing): a
-    walk snaps only while closing in on a point (the closest point of its last hop), not
-    on its own start unless it went round, and on a singular point only when it arrives
-    along one of that point's separatrices — in a dense layout (four holes) a walk
-    passing beside another singular point must not end there."""
+    under way is checked at once — by the rules of numerical tracing (core.layout.
+    field_rules: may_snap, arrives_along): a walk snaps only while closing in on a point,
+    not on its own start unless it went round, and on a singular point only when it
+    arrives along one of that point's separatrices.  A hop is longer than a tracing
+    step, so the distance is that of the hop's closest point, and the approach is seen
+    from where the hop began."""
 
     def __init__(self, targets, target_kind, field, origins):
         self.xy = np.asarray(targets, dtype=float).reshape(-1, 2)
@@ -204,15 +216,13 @@ class _SnapTargets:
         along = np.clip(np.einsum("atc,ac->at", rel, step) / length2, 0.0, 1.0)
         d = np.hypot(*(rel - along[..., None] * step[:, None, :]).transpose(2, 0, 1))
         before = np.hypot(*rel.transpose(2, 0, 1))
-        valid = (d <= SNAP * h) & (d < before)
-        own = self.own[walks]
-        valid &= ~(own & (self.corner[None] | (travelled[:, None] < 3 * SNAP * h)))
+        valid = may_snap(d, before, self.own[walks], self.corner[None], travelled[:, None], h)
         radial = -rel / np.maximum(before, 1e-300)[..., None]
         facing = np.nanmax(np.where(np.isnan(self.dirs[None, :, :, 0]), -np.inf,
                                     np.einsum("tsc,atc->ats", np.nan_to_num(self.dirs),
                                               radial)), axis=2)
-        valid &= ~self.singular[None] | (facing >= math.cos(SNAP_ANGLE))
-        order = np.argsort(d, axis=1)[:, :3]  # the three nearest, as tracing looks
+        valid &= ~self.singular[None] | arrives_along(facing)
+        order = np.argsort(d, axis=1)[:, :SNAP_CANDIDATES]  # the nearest, as tracing looks
         for a in range(len(points)):
             for j in order[a]:
                 if d[a, j] > SNAP * h:
@@ -351,15 +361,13 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
 
     Returns (streamlines, problems): each problem is (source description, reason).
     """
-    from ..core.tracing import _one_line_per_separatrix, _snap_targets, _sources, integrate
-
     h = mesh.element_size
     walker = mesh.walker
-    sources = _sources(mesh, field, walker, h)
+    sources = separatrix_sources(mesh, field, walker, h)
     vectors = LabelledVectors(mesh.nodes, field.frames, labels)
     boundary_ids = mesh.boundary_nodes
     boundary_tree = cKDTree(mesh.nodes[boundary_ids])
-    targets, target_kind = _snap_targets(mesh, field)
+    targets, target_kind = snap_targets(mesh, field)
     field_between = CrossField.on(mesh, field.theta)
     lines, failed, problems = [], [], []
     walks = walk_labels(domain, mesh, field, vectors, sources, boundary_tree, boundary_ids,
@@ -376,4 +384,4 @@ def reconstruct_streamlines(domain, mesh, field, labels) -> tuple[tuple, list]:
     if failed:
         traced = integrate(domain, mesh, field, failed, walker)
         lines.extend(dataclasses.replace(line, fallback=True) for line in traced)
-    return tuple(_one_line_per_separatrix(lines, h)), problems
+    return tuple(one_line_per_separatrix(lines, h)), problems

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from ..core.background import CORNER_MIN_TURN, _interior_angle
+from ..core.input.corners import interior_angle, is_corner
 
 
 def loop_corners(loop) -> list[int]:
@@ -18,8 +18,8 @@ def loop_corners(loop) -> list[int]:
         return []
     out = []
     for k, curve in enumerate(loop):
-        angle = _interior_angle(loop[k - 1], curve)
-        if abs(angle - math.pi) > CORNER_MIN_TURN:
+        angle = interior_angle(loop[k - 1], curve)
+        if is_corner(angle):
             out.append(int(round(angle / (math.pi / 2))))
     return out
 

@@ -14,7 +14,7 @@ import dataclasses
 
 import numpy as np
 
-from ..core.background import BackgroundMesh
+from ..core.field.background import BackgroundMesh
 from ..infer.encoding import canonical_angle
 
 JITTER = 0.15  # interior node movement, in element sizes

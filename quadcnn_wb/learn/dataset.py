@@ -25,11 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.atomic import write_atomic
-from ..core.background import background_mesh
-from ..core.domain import domain_from_json
-from ..core.partition import PartitionError, build_partition
-from ..core.reference import numerical_reference
-from ..core.transform import similarity, transform_domain_json
+from ..core.field.background import background_mesh
+from ..core.field.reference import numerical_reference
+from ..core.input.domain import domain_from_json
+from ..core.input.transform import similarity, transform_domain_json
+from ..core.layout.partition import build_partition
+from ..core.layout.partition_types import PartitionError
 from ..infer.encoding import ENCODING, encode, swap_labels
 from ..infer.rays import PAIRS, RAY_ENCODING, CrossField, field_rays, ray_features
 from .augment import jitter_nodes, smooth_deformation

@@ -24,8 +24,8 @@ def say(fraction: float, text: str) -> None:
 
 
 def run(variants_path, out, samples: int, epochs: int, seed: int, minutes, workers) -> Path:
-    from ..core.domain import domain_from_json
-    from ..core.reference import numerical_reference
+    from ..core.field.reference import numerical_reference
+    from ..core.input.domain import domain_from_json
     from ..infer.signature import topology_signature
     from .dataset import Variants, generate, save_dataset
     from .train import train

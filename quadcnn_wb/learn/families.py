@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..core.domain import Domain, domain_from_json
+from ..core.input.domain import Domain, domain_from_json
 
 
 @dataclass(frozen=True)

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..tracing import Endpoint
 from .crossings import crossings, cumulative_length, end_places
+from .streamlines import Endpoint
 
 SOURCE_KINDS = ("singularity", "corner")
 

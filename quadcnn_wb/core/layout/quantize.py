@@ -33,8 +33,8 @@ import numpy as np
 from scipy.optimize import Bounds, LinearConstraint, milp
 from scipy.sparse import coo_matrix, lil_matrix
 
-from ..partition import Partition, PartitionError
 from .collapse import conflicts, merges, node_layout
+from .partition_types import Partition, PartitionError
 
 
 def side_counts(partition: Partition, counts) -> list:

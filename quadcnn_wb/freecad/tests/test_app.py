@@ -29,8 +29,8 @@ class TestQuadCNNApp(unittest.TestCase):
         self.assertTrue(onnxruntime.__version__)
 
     def test_background_mesh_runs_in_freecad(self):
-        from quadcnn_wb.core.background import background_mesh
-        from quadcnn_wb.core.domain import load_domain
+        from quadcnn_wb.core.field.background import background_mesh
+        from quadcnn_wb.core.input.load import load_domain
 
         domain = load_domain(environment.resource_path("examples", "plate_hole.json"))
         mesh = background_mesh(domain, nodes=1000)
@@ -41,7 +41,7 @@ class TestQuadCNNApp(unittest.TestCase):
         self.assertLess(max(abs(r - 0.25) for r in radii), 1e-12)
 
     def test_bad_input_is_a_clear_error(self):
-        from quadcnn_wb.core.domain import DomainError, domain_from_json
+        from quadcnn_wb.core.input.domain import DomainError, domain_from_json
 
         with self.assertRaisesRegex(DomainError, "loop 0.*open loop"):
             domain_from_json({"loops": [[{"line": [[0, 0], [1, 0]]},

@@ -7,7 +7,7 @@ import unittest
 
 import FreeCAD
 
-from quadcnn_wb.core.domain import domain_from_json
+from quadcnn_wb.core.input.domain import domain_from_json
 from quadcnn_wb.freecad.design_variants import dimensions, make_variants
 from quadcnn_wb.freecad.sketches import plate_with_hole
 from quadcnn_wb.infer.signature import topology_signature

@@ -16,10 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..input.pose import canonical_pose
+from ..layout.collapse import conflicts, merges, node_layout, side_nodes
+from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_quads
-from .layout.collapse import conflicts, merges, node_layout, side_nodes
-from .partition import FreeFaceError, Partition, PartitionError
-from .pose import canonical_pose
+from .orientation import counter_clockwise_quads as _counter_clockwise  # the body's name
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3
@@ -243,15 +244,6 @@ def _coons(bottom, top, left, right) -> np.ndarray:
     return ((1 - v) * bottom[:, None, :] + v * top[:, None, :]
             + (1 - u) * left[None, :, :] + u * right[None, :, :]
             - ((1 - u) * (1 - v) * p00 + u * (1 - v) * p10 + (1 - u) * v * p01 + u * v * p11))
-
-
-def _counter_clockwise(nodes, quads):
-    p = nodes[quads]
-    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
-                        - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
-    out = quads.copy()
-    out[area < 0] = out[area < 0][:, ::-1]
-    return out
 
 
 def scaled_jacobians(nodes, quads) -> np.ndarray:

@@ -18,8 +18,9 @@ from __future__ import annotations
 import gmsh
 import numpy as np
 
-from .gmsh_session import gmsh_session, silenced_stdio
-from .partition import PartitionError, _fmt, inside_polygon
+from ..gmsh_session import gmsh_session, silenced_stdio
+from ..layout.partition_types import PartitionError, inside_polygon
+from ..layout.partition_types import fmt as _fmt  # the body's name
 
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 

@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .tracing import Endpoint, integrate
+from .streamlines import Endpoint
+from .tracing import integrate
 
 
 class _Components:

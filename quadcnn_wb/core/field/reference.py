@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..input.domain import Domain
+from ..layout.tracing import trace_streamlines
 from .background import BackgroundMesh, background_mesh
-from .domain import Domain
 from .framefield import FrameField, compute_frame_field
 from .labels import frame_labels
-from .tracing import trace_streamlines
 
 
 @dataclass(frozen=True)

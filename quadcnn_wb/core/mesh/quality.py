@@ -7,7 +7,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .background import _interior_angle
+from ..input.corners import interior_angle
 from .quadmesh import scaled_jacobians
 
 
@@ -22,7 +22,7 @@ def boundary_quads_expected(domain, nodes, boundary) -> np.ndarray:
                 continue
             dist, node = tree.query(curve.p0)
             if dist <= tol:
-                angle = _interior_angle(loop[k - 1], curve)
+                angle = interior_angle(loop[k - 1], curve)
                 expected[node] = max(1, int(round(angle / (math.pi / 2))))
     return expected
 

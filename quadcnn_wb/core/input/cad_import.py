@@ -13,9 +13,9 @@ from pathlib import Path
 import gmsh
 import numpy as np
 
+from ..gmsh_session import gmsh_session, silenced_stdio
 from .curves import Arc, Line, circumcenter
 from .domain import DomainError, make_domain
-from .gmsh_session import gmsh_session, silenced_stdio
 
 CURVE_TOLERANCE = 1e-4  # chordal deviation allowed for curves that are not lines or arcs
 EXACT_TOLERANCE = 1e-5  # a curve this close to a line or circle is taken as one (IGES

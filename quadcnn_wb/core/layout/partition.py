@@ -19,95 +19,22 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from .layout.crossings import crossings, end_places
+from .crossings import crossings, end_places
+from .partition_types import (
+    BoundaryPiece,
+    Edge,
+    FreeFace,
+    Partition,
+    PartitionError,
+    inside_polygon,
+)
+from .partition_types import fmt as _fmt  # the body's name
+from .subdivide import split_odd_faces
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
-
-
-class FreeFaceError(RuntimeError):
-    """A free face could not be filled; ``origins`` name its streamline edges, which a
-    rebuild may dissolve (merging the face with its neighbours)."""
-
-    def __init__(self, message, origins):
-        super().__init__(message)
-        self.origins = frozenset(origins)
-
-
-class PartitionError(RuntimeError):
-    """The streamlines do not cut the domain into four-sided blocks.
-
-    ``outline`` (when known) is the offending face's boundary, ``corners`` its corner
-    points, for pictures of what went wrong."""
-
-    def __init__(self, message, outline=None, corners=None):
-        super().__init__(message)
-        self.outline = outline
-        self.corners = corners
-
-
-@dataclass(frozen=True)
-class BoundaryPiece:
-    """Exact stretch of one boundary curve: parameter t0 to t1 of loops[loop][segment]."""
-
-    loop: int
-    segment: int
-    t0: float
-    t1: float
-
-
-@dataclass
-class Edge:
-    points: np.ndarray  # polyline from vertex a to vertex b
-    a: int
-    b: int
-    pieces: tuple = ()  # BoundaryPiece stretches, in order, for boundary edges
-    streamline: int = -1  # source streamline index for interior edges
-    origin: tuple = ()  # (streamline, a, b) of the edge before any split: names it across rebuilds
-
-    @property
-    def is_boundary(self) -> bool:
-        return bool(self.pieces)
-
-    @property
-    def length(self) -> float:
-        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
-
-
-@dataclass(frozen=True)
-class Block:
-    corners: tuple  # four vertex ids, counter-clockwise
-    sides: tuple  # four tuples of (edge id, forward) from corner k to corner k+1
-
-
-@dataclass(frozen=True)
-class FreeFace:
-    """A face of the arrangement that is no four-sided block, and why."""
-
-    halves: tuple  # (edge id, forward) around the face, the face on the left
-    reason: str
-    holes: tuple = ()  # rings of (edge id, forward) of the loops inside it
-
-    @property
-    def rings(self) -> tuple:
-        return (self.halves,) + tuple(self.holes)
-
-
-@dataclass
-class Partition:
-    vertices: np.ndarray  # (V, 2)
-    edges: list
-    blocks: list
-    cuts: list  # extra polylines added so that every face is a disk
-    singular: tuple = ()  # vertex ids of singular points: never merged with another anchor
-    free_faces: list = field(default_factory=list)  # FreeFace: unstructured quads there
-
-    def edge_points(self, e: int, forward: bool) -> np.ndarray:
-        pts = self.edges[e].points
-        return pts if forward else pts[::-1]
 
 
 # ----------------------------------------------------------------------------------------
@@ -198,7 +125,6 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
         if not slits:
             break
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
-    from .subdivide import split_odd_faces
 
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
@@ -390,16 +316,6 @@ def _outline(edges, halves) -> np.ndarray:
 def _polygon_area(pts) -> float:
     return 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1)
                               - np.roll(pts[:, 0], -1) * pts[:, 1]))
-
-
-def inside_polygon(polygon, p) -> bool:
-    """Even-odd rule: p strictly inside the closed polygon (points on it: either way)."""
-    x, y = p
-    inside = False
-    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
 
 
 def _slits(free, edges) -> set:
@@ -665,7 +581,3 @@ def _block_of(cycle, half, edges, vertices, h, head):
         sides.append([half[cycle[i]] for i in idx])
         corners.append(head(cycle[corner_at[s]]))
     return corners, sides
-
-
-def _fmt(p) -> str:
-    return f"({p[0]:.6g}, {p[1]:.6g})"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import write_atomic, write_json_atomic
+from ..atomic import write_atomic, write_json_atomic
 
 FORMATS = {".json", ".msh", ".vtk", ".inp"}
 

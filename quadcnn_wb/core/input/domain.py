@@ -9,10 +9,8 @@ every hole strictly inside the outer loop and outside the other holes, positive 
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -21,7 +19,6 @@ from .healing import HEAL_TOL, drop_crumbs, merge_curves, report_gaps
 from .intersections import Overlap, curve_intersections
 
 CLOSE_TOL = 1e-9  # relative to the domain size: what counts as exact
-CAD_SUFFIXES = {".step", ".stp", ".brep", ".brp", ".iges", ".igs"}
 
 
 class DomainError(ValueError):
@@ -66,27 +63,6 @@ class Domain:
     def to_json(self) -> dict:
         return {"units": self.units,
                 "loops": [[c.to_json() for c in loop] for loop in self.loops]}
-
-
-def load_domain(path) -> Domain:
-    """Domain from a Domain JSON v1 file or a STEP/BREP/IGES file (first planar face)."""
-    path = Path(path)
-    if path.suffix.lower() in CAD_SUFFIXES:
-        from .cad_import import read_cad_face
-
-        return read_cad_face(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DomainError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DomainError(f"{path}: cannot read: {exc}") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DomainError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno}, "
-                          f"column {exc.colno})") from None
-    return domain_from_json(data)
 
 
 def domain_from_json(data) -> Domain:

@@ -18,10 +18,11 @@ import time
 import gmsh
 import numpy as np
 
-from .background import _build_geometry
-from .gmsh_session import gmsh_session, silenced_stdio
-from .pose import Pose, canonical_pose
-from .quadmesh import QuadMesh, _counter_clockwise
+from ..gmsh_geometry import build_geometry
+from ..gmsh_session import gmsh_session, silenced_stdio
+from ..input.pose import Pose, canonical_pose
+from .orientation import counter_clockwise_quads
+from .quadmesh import QuadMesh
 from .quality import min_scaled_jacobian
 
 QUASI_STRUCTURED = 11  # gmsh's Mesh.Algorithm for quasi-structured quads
@@ -47,7 +48,7 @@ def gmsh_quasi_structured(domain, size: float):
     given, at gmsh mesh size ``size`` (elements of about size / 2): the peer of the
     benchmarks, timed on gmsh's meshing call alone."""
     with gmsh_session() as session:
-        _build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
+        build_geometry(domain, Pose(np.zeros(2), 1.0, np.eye(2)))  # as given
         for name, value in _quasi_structured_options(size):
             session.set(name, value)
         start = time.perf_counter()
@@ -77,7 +78,7 @@ def _recombined_options(size: float) -> tuple:
 
 def _gmsh_mesh(domain, pose, options) -> QuadMesh:
     with gmsh_session() as session:
-        curve_tags = _build_geometry(domain, pose)
+        curve_tags = build_geometry(domain, pose)
         for name, value in options:
             session.set(name, value)
         with silenced_stdio():
@@ -98,7 +99,7 @@ def _gmsh_mesh(domain, pose, options) -> QuadMesh:
     remap = np.full(len(nodes), -1)
     remap[used] = np.arange(len(used))
     nodes, boundary, quads = nodes[used], boundary[used], remap[quads]
-    quads = _counter_clockwise(nodes, quads)
+    quads = counter_clockwise_quads(nodes, quads)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=np.full(len(quads), -1),
                     boundary=boundary, edge_nodes=())
 

@@ -13,7 +13,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .partition import Block, BoundaryPiece, Edge, FreeFace, PartitionError, _fmt, inside_polygon
+from .partition_types import (
+    Block,
+    BoundaryPiece,
+    Edge,
+    FreeFace,
+    PartitionError,
+    fmt,
+    inside_polygon,
+)
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
@@ -36,7 +44,7 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
         if not inside_polygon(polygon, centre):
             halves = [h for side in sides for h in side]
             free_halves.append((halves, f"a {len(corners)}-cornered block near "
-                                f"{_fmt(centre)} is too concave to split into "
+                                f"{fmt(centre)} is too concave to split into "
                                 "quadrilaterals"))
             everything.append((None, [halves]))
             continue

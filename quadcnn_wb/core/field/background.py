@@ -18,16 +18,17 @@ import gmsh
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .curves import Arc, cross2
-from .domain import Domain
-from .gmsh_session import gmsh_session
-from .pose import KEY_DIGITS, Pose, canonical_pose
+from ..gmsh_geometry import UNIT_DIGITS, build_geometry
+from ..gmsh_session import gmsh_session
+from ..input.corners import interior_angle, is_corner
+from ..input.curves import Arc
+from ..input.domain import Domain
+from ..input.pose import KEY_DIGITS, canonical_pose
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
 #                  whole edges gain a node at once and the count moves in steps of ~20
 MAX_SIZE_ITERATIONS = 12
-CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not corners
 GMSH_ALGORITHM = 6  # Frontal-Delaunay: near-equilateral triangles, no smoothing needed
 GMSH_DENSITY = 1.045  # gmsh's frontal meshes hold this many times the ideal node count
 
@@ -158,7 +159,7 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
     with gmsh_session(threads) as session:
-        curve_tags = _build_geometry(domain, pose)
+        curve_tags = build_geometry(domain, pose)
         for option, value in (("Mesh.Algorithm", GMSH_ALGORITHM),
                               ("Mesh.MeshSizeFromPoints", 0),
                               ("Mesh.MeshSizeFromCurvature", 0),
@@ -185,80 +186,6 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
             f"{len(coords)}); the shape may have features far below the element size")
     coords = pose.from_unit(coords)
     return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale, pose.scale)
-
-
-UNIT_DIGITS = 9  # unit coordinates are rounded to this many decimals before gmsh: far
-#                 above the round-off of a part moved by 1e4 of its size (~1e-12)
-
-
-def unit(value):
-    """Round unit-scaled values so that a moved or rescaled copy of a part gives gmsh the
-    very same numbers (not numbers a rounding error apart, which can flip a Delaunay
-    decision and change the whole mesh)."""
-    return np.round(value, UNIT_DIGITS) + 0.0  # + 0.0: no negative zeros either
-
-
-def _unit_loops(domain: Domain, pose: Pose):
-    """The loops in unit coordinates, in an order that depends on the shape alone.
-
-    Each loop is a list of (loop index, segment index, start, middle or None, end) with the
-    domain on the left in the pose (a mirrored pose reverses the loops), starting at its
-    lowest-then-leftmost vertex; holes sorted by that vertex.  Full circles are
-    (loop index, centre, radius).
-    """
-    loops = []
-    for li, loop in enumerate(domain.loops):
-        if len(loop) == 1 and isinstance(loop[0], Arc) and loop[0].is_full:
-            c = loop[0]
-            loops.append((li, unit(pose.to_unit(c.center)), unit(c.radius / pose.scale)))
-            continue
-        pieces = []
-        for si, c in enumerate(loop):
-            mid = unit(pose.to_unit(c.midpoint())) if isinstance(c, Arc) else None
-            pieces.append((li, si, unit(pose.to_unit(c.p0)), mid, unit(pose.to_unit(c.p1))))
-        if pose.mirrored:
-            pieces = [(li, si, end, mid, start) for li, si, start, mid, end in pieces[::-1]]
-        first = min(range(len(pieces)), key=lambda k: (pieces[k][2][1], pieces[k][2][0]))
-        loops.append(pieces[first:] + pieces[:first])
-
-    def start_key(loop):
-        point = loop[1] if isinstance(loop, tuple) else loop[0][2]
-        return (point[1], point[0])
-
-    return [loops[0]] + sorted(loops[1:], key=start_key)
-
-
-def _build_geometry(domain: Domain, pose: Pose) -> dict:
-    """OCC curves for every domain curve, in unit coordinates; returns tag -> (loop, seg)."""
-    occ = gmsh.model.occ
-    curve_tags = {}
-    loop_tags = []
-    helpers = []
-    for loop in _unit_loops(domain, pose):
-        if isinstance(loop, tuple):
-            li, q, radius = loop
-            tag = occ.addCircle(q[0], q[1], 0.0, radius)
-            curve_tags[tag] = (li, 0)
-            loop_tags.append(occ.addCurveLoop([tag]))
-            continue
-        vertices = [occ.addPoint(start[0], start[1], 0.0) for _, _, start, _, _ in loop]
-        tags = []
-        for k, (li, si, _, mid, _) in enumerate(loop):
-            start, end = vertices[k], vertices[(k + 1) % len(loop)]
-            if mid is not None:
-                helper = occ.addPoint(mid[0], mid[1], 0.0)
-                helpers.append(helper)
-                tag = occ.addCircleArc(start, helper, end, center=False)
-            else:
-                tag = occ.addLine(start, end)
-            curve_tags[tag] = (li, si)
-            tags.append(tag)
-        loop_tags.append(occ.addCurveLoop(tags))
-    occ.addPlaneSurface(loop_tags)
-    if helpers:
-        occ.remove([(0, t) for t in helpers])
-    occ.synchronize()
-    return curve_tags
 
 
 def _read_mesh(curve_tags: dict):
@@ -315,8 +242,8 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
             params.extend(t)
             tangents.extend(np.atleast_2d(curve.tangent(t)))
             if len(loop) > 1 or not getattr(curve, "is_full", False):
-                angle = _interior_angle(loop[si - 1], curve)
-                if abs(angle - math.pi) > CORNER_MIN_TURN:
+                angle = interior_angle(loop[si - 1], curve)
+                if is_corner(angle):
                     corner_nodes.append(int(ids[0]))
                     corner_angles.append(angle)
                     corner_in.append(loop[si - 1].tangent(1.0))
@@ -331,13 +258,6 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
         corner_angles=np.array(corner_angles, dtype=float),
         corner_tangents_in=np.array(corner_in, dtype=float).reshape(-1, 2),
         element_size=float(h))
-
-
-def _interior_angle(incoming, outgoing) -> float:
-    """Angle on the domain's side (the left) between consecutive curves at their joint."""
-    t_in, t_out = incoming.tangent(1.0), outgoing.tangent(0.0)
-    turn = math.atan2(cross2(t_in, t_out), float(np.dot(t_in, t_out)))
-    return math.pi - turn
 
 
 def _counter_clockwise(coords, triangles):

@@ -1,0 +1,1 @@
+"""Field stage: background triangle mesh, cross (frame) field, labels, the reference."""

@@ -1,0 +1,1 @@
+"""Input stage: exact boundary curves, validated into a Domain (JSON or CAD), its pose."""

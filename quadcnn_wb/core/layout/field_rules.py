@@ -1,0 +1,242 @@
+"""How a line follows the cross field: the rules every way of finding streamlines shares.
+
+Three things walk along the field: numerical tracing (tracing.py, the reference), the
+rebuild from network labels (infer/reconstruct.py, which traces numerically what it
+cannot trust) and the coarse ray hints the network is given (infer/rays.py).  They march
+differently on purpose (a quarter element per RK2 step, hops between labelled nodes,
+whole-element steps of all rays at once), but they must agree on where separatrices
+start, on the field between the nodes, on when a line has arrived at a singular point
+or a concave corner, and on which of two lines along one separatrix is kept: otherwise
+a rebuilt line ends elsewhere than the traced one and the partitions differ.  Those
+rules live here, once.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .streamlines import Endpoint, Streamline
+
+SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes
+SNAP_ANGLE = math.radians(45)  # an approach must be this close to a separatrix to snap
+MAX_LENGTH = 4.0  # streamlines longer than this many domain diagonals are capped
+ROUND_TRIP = 3.0  # a line may end on its own source once it went this many SNAP radii
+SNAP_CANDIDATES = 3  # a line is tested against this many nearest targets, nearest first
+MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
+
+
+# ----------------------------------------------------------------------------------------
+# The field between the nodes
+
+
+def cross_angle(z: np.ndarray, triangles: np.ndarray, tri: np.ndarray,
+                bary: np.ndarray) -> np.ndarray:
+    """One cross arm's angle (radians) at points inside triangles ``tri``, barycentric
+    coordinates ``bary``: the nodes' z = exp(4it) interpolated linearly, a quarter of its
+    argument.  Interpolating z, not the angles, is what makes the four arms agree: the
+    nodes' angles may differ by quarter turns that mean the same cross."""
+    return np.angle((z[triangles[tri]] * bary).sum(axis=1)) / 4.0
+
+
+def nearest_arm(theta: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Unit vector of the cross arm (angle theta + k·90°) nearest to each direction d.
+
+    A streamline keeps to the arm it travels along; the other three belong to the
+    crossing family (two of them) and to going back."""
+    a = np.arctan2(d[:, 1], d[:, 0])
+    k = np.rint((a - theta) / (np.pi / 2))
+    phi = theta + k * (np.pi / 2)
+    return np.column_stack([np.cos(phi), np.sin(phi)])
+
+
+# ----------------------------------------------------------------------------------------
+# Where lines start and where they may end
+
+
+def separatrix_sources(mesh, field, walker, h) -> list:
+    """(start xy, unit direction, start triangle, start Endpoint) of every separatrix:
+    each direction of each singular point, then each direction of each source corner.
+
+    A corner's start triangle is the one the first step goes into: the corner node
+    touches several, and the walk must begin in the one on the direction's side."""
+    out = []
+    for si, sing in enumerate(field.singularities):
+        for k, d in enumerate(sing.directions):
+            out.append((sing.xy, d, sing.triangle, Endpoint("singularity", si, branch=k)))
+    incident = {}
+    for t, tri in enumerate(mesh.triangles):
+        for n in tri:
+            incident.setdefault(int(n), []).append(t)
+    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    for cs in field.corner_sources:
+        k = position[cs.node]
+        corner = Endpoint("corner", cs.node, int(mesh.boundary_loop[k]),
+                          int(mesh.boundary_segment[k]), 0.0)
+        for branch, d in enumerate(cs.directions):
+            probe = cs.xy + 1e-6 * h * d
+            tris = np.array(incident[cs.node])
+            b = walker.barycentric(tris, np.repeat(probe[None], len(tris), axis=0))
+            t0 = int(tris[np.argmax(b.min(axis=1))])
+            out.append((cs.xy, d, t0, Endpoint(corner.kind, corner.index, corner.loop,
+                                               corner.segment, 0.0, branch)))
+    return out
+
+
+def snap_targets(mesh, field) -> tuple[np.ndarray, list]:
+    """((T, 2) places, their Endpoints) a line may end at: the singular points, then the
+    source corners (branch left open: which separatrix it arrives along is decided on
+    arrival)."""
+    xy = [s.xy for s in field.singularities] + [c.xy for c in field.corner_sources]
+    kind = [Endpoint("singularity", i) for i in range(len(field.singularities))]
+    for c in field.corner_sources:
+        k = int(np.nonzero(mesh.boundary_nodes == c.node)[0][0])
+        kind.append(Endpoint("corner", c.node, int(mesh.boundary_loop[k]),
+                             int(mesh.boundary_segment[k]), 0.0))
+    return np.array(xy).reshape(-1, 2), kind
+
+
+def may_snap(distance, before, own, corner, travelled, h):
+    """Whether a line may end on a target ``distance`` away (``before``: that distance a
+    step earlier): within SNAP sizes, closing in on it, and, when the target is the
+    line's own source, only after going round (ROUND_TRIP) and never at a corner.
+
+    Closing in, not merely near: a line leaving a singular point that happens to sit
+    next to another must not end on it at once.  Elementwise on scalars or arrays."""
+    near = np.logical_and(distance <= SNAP * h, distance < before)
+    too_soon = np.logical_or(corner, travelled < ROUND_TRIP * SNAP * h)
+    return np.logical_and(near, np.logical_not(np.logical_and(own, too_soon)))
+
+
+def arrives_along(alignment):
+    """Whether an approach whose direction has cosine ``alignment`` with a singular
+    point's separatrix arrives along it (within SNAP_ANGLE).  In a dense layout (four
+    holes) a line passing beside another singular point must not end there."""
+    return alignment >= math.cos(SNAP_ANGLE)
+
+
+# ----------------------------------------------------------------------------------------
+# One line per separatrix
+
+
+def claim_separatrices(lengths, starts, ends) -> tuple[list, dict]:
+    """(indices of the lines to keep, sorted; {kept line: line holding its end slot}).
+
+    A line from source a that arrives at b along b's separatrix k *is* that separatrix
+    of b, so it claims two slots: ``starts[i]`` and ``ends[i]`` (None: it ends where no
+    separatrix starts, on the boundary).  Shorter lines claim first, as a short
+    connection between two singular points is the most trustworthy line.  A line whose
+    start slot is still free but whose end slot is taken still stays (its own
+    separatrix would be missing otherwise), joined to the line holding that slot.
+    """
+    order = sorted(range(len(lengths)), key=lambda i: lengths[i])
+    owner, keep, joins = {}, set(), {}
+    for i in order:
+        mine = {starts[i], ends[i]} - {None}
+        if not any(m in owner for m in mine):
+            keep.add(i)
+            owner.update({m: i for m in mine})
+    for i in order:
+        start, end = starts[i], ends[i]
+        if i in keep:
+            continue
+        if start is not None and start not in owner:
+            keep.add(i)
+            owner[start] = i
+            if end is not None and end in owner:
+                joins[i] = owner[end]
+    return sorted(keep), joins
+
+
+def one_line_per_separatrix(lines: list, h: float) -> list:
+    """One streamline per separatrix (claim_separatrices).
+
+    b's own trace of a separatrix that another line arrives along (which may have
+    wandered elsewhere: tracing leaves a singular point less reliably than it arrives)
+    goes; a line that has to stay although its end slot is taken ends on the line holding
+    that slot where it meets it, as a T-junction, instead of piling a second line onto
+    the same separatrix.
+    """
+    def slot(e):
+        return (e.kind, e.index, e.branch) if e.branch >= 0 else None
+
+    lines = _arrival_branches(lines, h)
+    final, joins = claim_separatrices([line.length for line in lines],
+                                      [slot(line.start) for line in lines],
+                                      [slot(line.end) for line in lines])
+    position = {i: k for k, i in enumerate(final)}
+    out = []
+    for i in final:
+        line = lines[i]
+        if i in joins:
+            line = _join(line, lines[joins[i]], position[joins[i]], h)
+        out.append(line)
+    return out
+
+
+def _arrival_branches(lines, h):
+    """Which separatrix of its end point (singular point or concave corner) each arriving
+    streamline runs along.
+
+    The direction of arrival alone is ambiguous next to a singular point (the field turns
+    fast there), so compare the arriving line with the point's own traced separatrices
+    over the first few element sizes: it arrives along the one it lies closest to.
+    """
+    leaving = {(ln.start.kind, ln.start.index, ln.start.branch): ln for ln in lines}
+    out = []
+    for line in lines:
+        end = line.end
+        if not any(key[:2] == (end.kind, end.index) for key in leaving):
+            out.append(line)  # the boundary, or a convex corner: no separatrices there
+            continue
+        tree = cKDTree(_densify(line.points, 0.25 * h))
+        best, best_dist = end.branch, np.inf
+        for (kind, index, branch), own in leaving.items():
+            if (kind, index) != (end.kind, end.index):
+                continue
+            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= 3 * h]
+            if len(near) < 2:
+                continue
+            d = float(tree.query(near[1:])[0].mean())
+            if d < best_dist:
+                best, best_dist = branch, d
+        out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
+    return out
+
+
+def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
+    """End ``line`` on ``other`` where it first comes within MERGE sizes of it."""
+    dense = _densify(other.points, 0.25 * h)
+    dist = cKDTree(dense).query(line.points)[0]
+    close = np.nonzero(dist <= MERGE * h)[0]
+    close = close[close > 0]
+    if not len(close):
+        return line
+    head = int(close[0])
+    point, param = _nearest_on_polyline(other.points, line.points[head])
+    return dataclasses.replace(line, points=np.vstack([line.points[:head], point]),
+                               end=Endpoint("streamline", other_index, param=param))
+
+
+def _densify(points, spacing):
+    seg = np.diff(points, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / spacing).astype(int))
+    parts = [points[i] + np.outer(np.arange(k) / k, seg[i]) for i, k in enumerate(n)]
+    return np.vstack(parts + [points[-1:]])
+
+
+def _nearest_on_polyline(points, p):
+    """Closest point to p on the polyline, and its arc-length fraction along it."""
+    a, b = points[:-1], points[1:]
+    d = b - a
+    len2 = np.maximum((d * d).sum(axis=1), 1e-300)
+    t = np.clip(((p - a) * d).sum(axis=1) / len2, 0.0, 1.0)
+    q = a + t[:, None] * d
+    k = int(np.argmin(np.hypot(*(q - p).T)))
+    seglen = np.sqrt(len2)
+    total = float(seglen.sum())
+    along = float(seglen[:k].sum() + t[k] * seglen[k])
+    return q[k], along / total if total > 0 else 0.0

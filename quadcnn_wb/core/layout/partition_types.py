@@ -1,0 +1,112 @@
+"""The block partition's data: its edges, blocks and free faces, and its errors.
+
+The partition (partition.py) makes them, the subdivision of odd faces (subdivide.py)
+and segment counting (quantize.py) rework them, the mesh builder (mesh/quadmesh.py,
+mesh/free_faces.py) fills them; kept apart from the building so that each of those
+imports the data and not one another.  With them, the two small helpers every stage that
+checks a face uses: the even-odd point-in-polygon test and how an error message names a
+point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+class FreeFaceError(RuntimeError):
+    """A free face could not be filled; ``origins`` name its streamline edges, which a
+    rebuild may dissolve (merging the face with its neighbours)."""
+
+    def __init__(self, message, origins):
+        super().__init__(message)
+        self.origins = frozenset(origins)
+
+
+class PartitionError(RuntimeError):
+    """The streamlines do not cut the domain into four-sided blocks.
+
+    ``outline`` (when known) is the offending face's boundary, ``corners`` its corner
+    points, for pictures of what went wrong."""
+
+    def __init__(self, message, outline=None, corners=None):
+        super().__init__(message)
+        self.outline = outline
+        self.corners = corners
+
+
+@dataclass(frozen=True)
+class BoundaryPiece:
+    """Exact stretch of one boundary curve: parameter t0 to t1 of loops[loop][segment]."""
+
+    loop: int
+    segment: int
+    t0: float
+    t1: float
+
+
+@dataclass
+class Edge:
+    points: np.ndarray  # polyline from vertex a to vertex b
+    a: int
+    b: int
+    pieces: tuple = ()  # BoundaryPiece stretches, in order, for boundary edges
+    streamline: int = -1  # source streamline index for interior edges
+    origin: tuple = ()  # (streamline, a, b) of the edge before any split: names it across rebuilds
+
+    @property
+    def is_boundary(self) -> bool:
+        return bool(self.pieces)
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+@dataclass(frozen=True)
+class Block:
+    corners: tuple  # four vertex ids, counter-clockwise
+    sides: tuple  # four tuples of (edge id, forward) from corner k to corner k+1
+
+
+@dataclass(frozen=True)
+class FreeFace:
+    """A face of the arrangement that is no four-sided block, and why."""
+
+    halves: tuple  # (edge id, forward) around the face, the face on the left
+    reason: str
+    holes: tuple = ()  # rings of (edge id, forward) of the loops inside it
+
+    @property
+    def rings(self) -> tuple:
+        return (self.halves,) + tuple(self.holes)
+
+
+@dataclass
+class Partition:
+    vertices: np.ndarray  # (V, 2)
+    edges: list
+    blocks: list
+    cuts: list  # extra polylines added so that every face is a disk
+    singular: tuple = ()  # vertex ids of singular points: never merged with another anchor
+    free_faces: list = field(default_factory=list)  # FreeFace: unstructured quads there
+
+    def edge_points(self, e: int, forward: bool) -> np.ndarray:
+        pts = self.edges[e].points
+        return pts if forward else pts[::-1]
+
+
+def inside_polygon(polygon, p) -> bool:
+    """Even-odd rule: p strictly inside the closed polygon (points on it: either way)."""
+    x, y = p
+    inside = False
+    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
+
+
+def fmt(p) -> str:
+    """A point as error messages write it."""
+    return f"({p[0]:.6g}, {p[1]:.6g})"

@@ -1,0 +1,1 @@
+"""Mesh stage: quads in the blocks and free faces, gmsh's fallback, quality, export."""

@@ -1,0 +1,20 @@
+"""Quads turned counter-clockwise: the orientation every quad mesh here is handed on in.
+
+The block maps (quadmesh.py) and gmsh's quads (gmsh_quads.py) come out in either
+orientation; scaled Jacobians, the exports and the FreeCAD mesh all read a quad's
+corners counter-clockwise, so both pass their quads through the same rule.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def counter_clockwise_quads(nodes: np.ndarray, quads: np.ndarray) -> np.ndarray:
+    """A copy of ``quads`` (Q, 4) with every clockwise quad's corners reversed."""
+    p = nodes[quads]
+    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
+                        - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
+    out = quads.copy()
+    out[area < 0] = out[area < 0][:, ::-1]
+    return out
