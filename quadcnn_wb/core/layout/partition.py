@@ -29,9 +29,9 @@ from .partition_types import (
     FreeFace,
     Partition,
     PartitionError,
+    fmt,
     inside_polygon,
 )
-from .partition_types import fmt as _fmt  # the body's name
 from .subdivide import split_odd_faces
 
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
@@ -285,7 +285,7 @@ def _with_holes(blocks, free, islands, edges, h) -> tuple:
         probe = _left_of(_outline(edges, island), 1e-3 * h)
         around = [k for k, o in enumerate(outlines) if inside_polygon(o, probe)]
         if not around:
-            raise PartitionError(f"a loop near {_fmt(probe)} lies in no face")
+            raise PartitionError(f"a loop near {fmt(probe)} lies in no face")
         k = min(around, key=lambda k: abs(_polygon_area(outlines[k])))
         holes.setdefault(k, []).append(island)
     out_blocks, out_free = [], []
@@ -418,7 +418,7 @@ def _direction(points: np.ndarray, reach: float) -> np.ndarray:
         d = points[-1] - points[0]
         n = np.hypot(*d)
     if n == 0:
-        raise PartitionError(f"a partition edge has zero length at {_fmt(points[0])}")
+        raise PartitionError(f"a partition edge has zero length at {fmt(points[0])}")
     return d / n
 
 
@@ -559,11 +559,11 @@ def _block_of(cycle, half, edges, vertices, h, head):
     if np.any(turns < -CORNER_TURN):
         k = int(np.argmin(turns))
         raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
-                             f"{_fmt(vertices[head(cycle[k])])}: not a four-sided block")
+                             f"{fmt(vertices[head(cycle[k])])}: not a four-sided block")
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
     if len(corner_at) not in (3, 4, 5):
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
-        raise PartitionError(f"a block near {_fmt(centre)} has {len(corner_at)} corners "
+        raise PartitionError(f"a block near {fmt(centre)} has {len(corner_at)} corners "
                              f"instead of 4", outline, tips[corner_at])
     n_sides = len(corner_at)
     sides = []

@@ -19,8 +19,7 @@ import gmsh
 import numpy as np
 
 from ..gmsh_session import gmsh_session, silenced_stdio
-from ..layout.partition_types import PartitionError, inside_polygon
-from ..layout.partition_types import fmt as _fmt  # the body's name
+from ..layout.partition_types import PartitionError, fmt, inside_polygon
 
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 
@@ -33,7 +32,7 @@ def free_face_quads(rings, pose) -> tuple:
     rings = [np.asarray(r, dtype=float) for r in rings]
     centre = rings[0].mean(axis=0)
     if any(len(r) % 2 for r in rings) or len(rings[0]) < 6:
-        raise PartitionError(f"a free face near {_fmt(centre)} has {len(rings[0])} side "
+        raise PartitionError(f"a free face near {fmt(centre)} has {len(rings[0])} side "
                              "segments (an even number >= 6 is needed)")
     units, orders, offset = [], [], 0
     for ring in rings:
@@ -48,7 +47,7 @@ def free_face_quads(rings, pose) -> tuple:
         orders.append(order + offset)
         offset += len(ring)
     if not rings_are_simple([u[0::2] for u in units]):
-        raise PartitionError(f"a free face near {_fmt(centre)} touches or crosses itself: "
+        raise PartitionError(f"a free face near {fmt(centre)} touches or crosses itself: "
                              "no polygon to fill")
     interior, quads = _gmsh_fill(units)
     order = np.concatenate(orders)
@@ -165,7 +164,7 @@ def _gmsh_fill(units) -> tuple:
             with silenced_stdio():
                 gmsh.model.mesh.generate(2)
         except Exception as exc:  # gmsh reports every failure as a bare Exception
-            raise PartitionError(f"gmsh could not fill a free face near {_fmt(centre)}: "
+            raise PartitionError(f"gmsh could not fill a free face near {fmt(centre)}: "
                                  f"{exc}") from None
         index = {}
         for tag, local in point_of.items():
@@ -181,6 +180,6 @@ def _gmsh_fill(units) -> tuple:
             index[int(tag)] = offset + k
         types, _, node_tags = gmsh.model.mesh.getElements(2, surface)
         if list(types) != [3]:
-            raise PartitionError(f"gmsh left triangles in a free face near {_fmt(centre)}")
+            raise PartitionError(f"gmsh left triangles in a free face near {fmt(centre)}")
         quads = np.array([index[int(t)] for t in node_tags[0]], dtype=np.int64).reshape(-1, 4)
     return interior, quads

@@ -20,7 +20,7 @@ from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_quads
-from .orientation import counter_clockwise_quads as _counter_clockwise  # the body's name
+from .orientation import counter_clockwise_quads
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3
@@ -140,7 +140,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
                              "corner", sorted({int(b) for b in owner[squashed] if b >= 0}))
     boundary = np.zeros(len(nodes), dtype=bool)
     boundary[list(boundary_ids)] = True
-    quads = _counter_clockwise(nodes, quads)
+    quads = counter_clockwise_quads(nodes, quads)
     if smoothing:
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
     edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
