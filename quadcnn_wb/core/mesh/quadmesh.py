@@ -188,6 +188,7 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
 
 
 UNTANGLE_PASSES = 30
+UNTANGLE_RINGS = 3
 
 
 def _untangled(points, local, n_ring) -> np.ndarray:
@@ -204,7 +205,18 @@ def _untangled(points, local, n_ring) -> np.ndarray:
     relaxed = _laplacian(points, local, fixed, UNTANGLE_PASSES)
     if _sj_batch(relaxed[local]).min() > _sj_batch(points[local]).min():
         points = relaxed
-    return improve_worst(points, local, fixed, passes=UNTANGLE_PASSES, share=1.0)
+    # Only around the folds (a big face has thousands of quads that are fine): the quads
+    # within UNTANGLE_RINGS of an inverted one move, the nodes on that patch's rim stay.
+    near = _sj_batch(points[local]) <= 0
+    if not near.any():
+        return points
+    for _ in range(UNTANGLE_RINGS):
+        touched = np.zeros(len(points), dtype=bool)
+        touched[local[near].ravel()] = True
+        near = touched[local].any(axis=1)
+    rim = np.zeros(len(points), dtype=bool)
+    rim[local[~near].ravel()] = True
+    return improve_worst(points, local[near], fixed | rim, passes=UNTANGLE_PASSES, share=1.0)
 
 
 def _laplacian(points, quads, fixed, iterations) -> np.ndarray:
