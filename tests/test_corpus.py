@@ -122,3 +122,24 @@ def test_a_part_with_free_faces_gets_the_same_mesh_in_every_pose():
         moved = transform_domain_json(data, similarity(degrees, scale, mirror),
                                       np.full(2, shift * size * scale))
         assert signature(mesh_domain(domain_from_json(moved))) == signature(base), degrees
+
+
+POSES = ((37.0, False, 1.0, 0.0), (0.0, False, 1.0, 1e4), (211.0, True, 1.0, 0.0),
+         (131.0, False, 1e-3, 3.0), (0.0, False, 1e3, 0.0))
+
+
+@pytest.mark.parametrize("name", MESHABLE)
+def test_every_part_is_accepted_in_every_pose(name):
+    # Validation must not hang on round-off: sketch_gasket moved by 1e4 of its size had a
+    # hole "outside" its outer loop (a probe point on the chord of a boss's arc).
+    import numpy as np
+
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.transform import similarity, transform_domain_json
+
+    domain = load_domain(CORPUS / PARTS[name]["file"])
+    data = domain.to_json()
+    for degrees, mirror, scale, shift in POSES:
+        moved = transform_domain_json(data, similarity(degrees, scale, mirror),
+                                      np.full(2, shift * domain.size * scale))
+        assert len(domain_from_json(moved).loops) == len(domain.loops), (degrees, shift)

@@ -232,13 +232,15 @@ def winding_numbers(loop, points: np.ndarray) -> np.ndarray:
     total = np.zeros(len(q))
     for c in loop:
         a, b = c.p0 - q, c.p1 - q
-        total += np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))
+        cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        total += np.arctan2(cross, (a * b).sum(axis=1))
         if isinstance(c, Arc):
             inside = np.hypot(*(q - c.center).T) < c.radius
             if not c.is_full:
-                chord = c.p1 - c.p0
-                rel = q - c.p0
-                side = chord[0] * rel[:, 1] - chord[1] * rel[:, 0]
-                inside &= side * cross2(chord, c.midpoint() - c.p0) > 0.0
+                # Which side of the chord q lies on: the very number whose sign chose the
+                # chord's angle above (+pi or -pi for q near the chord), so that round-off
+                # cannot pick one side there and the other here (a moved copy of a part
+                # had a hole "outside" its outer loop).
+                inside &= cross * cross2(c.p1 - c.p0, c.midpoint() - c.p0) > 0.0
             total += np.where(inside, TWO_PI if c.sweep > 0 else -TWO_PI, 0.0)
     return np.rint(total / TWO_PI).astype(int)
