@@ -148,7 +148,7 @@ def _rotation(domain, center, scale, points, circles) -> np.ndarray:
 
     The edge: the longest; ties go to the one farther from the centroid, then to the one
     whose start is farther; without straight edges, the direction from the centroid to
-    the farthest sample (or to the first hole's centre) serves.
+    the farthest sample (or to the farthest circle's centre) serves.
     """
     best_key, direction = None, None
     for loop in domain.loops:
@@ -164,10 +164,26 @@ def _rotation(domain, center, scale, points, circles) -> np.ndarray:
         if len(points):
             far = np.hypot(*(points - center).T)
             direction = points[int(np.argmax(np.round(far / scale, KEY_DIGITS)))] - center
-        elif len(circles) > 1:
-            direction = circles[1].center - center
         else:
-            direction = np.array([1.0, 0.0])
+            direction = _towards_a_circle(circles, center, scale)
     angle = -math.atan2(direction[1], direction[0])
     c, s = math.cos(angle), math.sin(angle)
     return np.array([[c, -s], [s, c]])
+
+
+def _towards_a_circle(circles, center, scale) -> np.ndarray:
+    """For a part of full circles only: towards the centre farthest from the centroid
+    (ties: the larger circle, then input order, which a symmetric pattern makes
+    immaterial).  Circles about the centroid itself give no direction (one concentric
+    with it once made round-off pick the pose); all of them concentric: any direction
+    gives gmsh the same circles."""
+    best_key, direction = None, np.array([1.0, 0.0])
+    for c in circles:
+        offset = np.asarray(c.center, dtype=float) - center
+        distance = _key(float(np.hypot(*offset)), scale)
+        if distance <= 10.0 ** -(KEY_DIGITS - 3):
+            continue
+        key = (distance, _key(c.radius, scale))
+        if best_key is None or key > best_key:
+            best_key, direction = key, offset
+    return direction
