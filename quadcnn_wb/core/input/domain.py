@@ -166,16 +166,28 @@ def make_domain(loops, units: str = "mm") -> Domain:
     return domain
 
 
+RAW_SAMPLES = 8  # points per curve for the raw size
+
+
 def _raw_size(loops) -> float:
+    """The largest distance across the raw curves, sampled at fixed parameters: the scale
+    of the closing and healing tolerances.  Unlike a bounding box it is the same for a
+    turned copy, so the copy gets the same curves merged (a bounding-box tolerance merged
+    two arcs of crank_arm_web turned by 37° and not in its own pose)."""
+    t = np.linspace(0.0, 1.0, RAW_SAMPLES + 1)
     pts = []
     for loop in loops:
         for c in loop:
-            if isinstance(c, tuple):
-                pts.extend(c)
-            else:
-                pts.extend(curve_bbox(c))
-    pts = np.array(pts)
-    size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0))))
+            pts.extend(c if isinstance(c, tuple) else c.point(t))
+    pts = np.unique(np.array(pts, dtype=float), axis=0)
+    if len(pts) > 3:
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            pts = pts[ConvexHull(pts).vertices]
+        except QhullError:
+            pass  # all on one line: every point is a candidate
+    size = float(np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1).max()))
     if size == 0.0:
         raise DomainError("the domain has zero area (all its points coincide)")
     return size
