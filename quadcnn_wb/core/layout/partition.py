@@ -449,6 +449,40 @@ def _into_the_domain(items, half, edges) -> None:
         items[k] = (math.atan2(math.sin(target), math.cos(target)), hid)
 
 
+SAME_DIRECTION = 1e-7  # radians: two edges leaving a vertex this close run together
+FARTHER = (1.0, 2.0, 4.0)  # reaches (element sizes) that tell such edges apart
+
+
+def _around(items, half, edges, h) -> list:
+    """The (angle, half) items of a vertex in counter-clockwise order.  Edges leaving in
+    one direction (two clamped into the domain's sector alike, a trace starting along
+    another) are ordered by where they head farther on, not by their numbers, which a
+    mirrored or turned copy of the part does not share."""
+    items = sorted(items)
+    if len(items) < 2:
+        return items
+
+    def farther(hid, reach):
+        e, forward = half[hid]
+        pts = edges[e].points if forward else edges[e].points[::-1]
+        d = _direction(pts, min(reach * h, edges[e].length))
+        return math.atan2(d[1], d[0])
+
+    out, k = [], 0
+    while k < len(items):
+        run = [items[k]]
+        while k + len(run) < len(items) and \
+                items[k + len(run)][0] - run[-1][0] <= SAME_DIRECTION:
+            run.append(items[k + len(run)])
+        if len(run) > 1:
+            run.sort(key=lambda item, base=run[0][0]: tuple(
+                round(math.atan2(math.sin(farther(item[1], r) - base),
+                                 math.cos(farther(item[1], r) - base)), 9) for r in FARTHER))
+        out.extend(run)
+        k += len(run)
+    return out
+
+
 def _faces_to_blocks(vertices, edges, h):
     reach = 0.5 * h
     half = []  # (edge id, forward)
@@ -464,7 +498,8 @@ def _faces_to_blocks(vertices, edges, h):
     order = {}
     for v, items in out_dirs.items():
         _into_the_domain(items, half, edges)
-        items.sort()
+        items = _around(items, half, edges, h)
+        out_dirs[v] = items
         for k, (_, hid) in enumerate(items):
             order[hid] = (v, k)
     twin = {}

@@ -88,6 +88,7 @@ def _rows(entries: list, n_columns: int):
 
 MAX_ROUNDS = 30  # conflict rows added one solve at a time
 MIN_FREE_FACE_HALVES = 3  # a free face's outline at half resolution: at least a triangle
+TIE_BREAK = 1e-6  # squared segments per segment, at most: orders equal-cost counts
 FREE_BLOCK_COST = 1000.0  # a block given up to unstructured quads, in squared segments
 
 
@@ -191,7 +192,11 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
                      0, np.inf))
     problem = _Problem(n_edges, n_blocks, rows)
     secants = _secant_rows(target, lower, upper, problem.n_columns)
-    cost = np.concatenate([np.zeros(n_edges), np.ones(n_edges), np.zeros(n_edges),
+    # Ties broken by the geometric order: equal-cost counts (two edges of one length
+    # whose sum is fixed) would otherwise go to whichever the solver meets first, and a
+    # turned copy, whose rows come in another order, got the other one.
+    tie_break = TIE_BREAK * np.arange(1, n_edges + 1) / n_edges
+    cost = np.concatenate([tie_break, np.ones(n_edges), np.zeros(n_edges),
                            np.full(n_blocks, FREE_BLOCK_COST)])
     integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges), np.ones(n_edges),
                                   np.ones(n_blocks)])
@@ -204,7 +209,7 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
         extra = [(dict.fromkeys(f, 1), 1, np.inf) for f in forbidden]
         result = milp(cost, constraints=[secants, problem.constraint(extra)],
                       integrality=integrality, bounds=bounds,
-                      options={"time_limit": time_limit})
+                      options={"time_limit": time_limit, "mip_rel_gap": 0.0})
         if result.x is None:
             error = InfeasibleCounts if result.status == 2 else PartitionError  # 2: infeasible
             raise error(f"no segment counts make opposite block sides equal "

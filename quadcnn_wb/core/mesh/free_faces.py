@@ -18,6 +18,7 @@ from __future__ import annotations
 import gmsh
 import numpy as np
 
+from ..gmsh_geometry import unit as rounded_unit
 from ..gmsh_session import gmsh_session, silenced_stdio
 from ..layout.partition_types import PartitionError, fmt, inside_polygon
 
@@ -36,7 +37,9 @@ def free_face_quads(rings, pose) -> tuple:
                              "segments (an even number >= 6 is needed)")
     units, orders, offset = [], [], 0
     for ring in rings:
-        unit = pose.to_unit(ring)
+        # Rounded as the background's geometry is: a turned copy hands gmsh the very same
+        # numbers, not numbers a rounding error apart (which changed the quads).
+        unit = rounded_unit(pose.to_unit(ring))
         order = np.arange(len(ring))
         if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
             order = np.concatenate([[0], np.arange(len(ring) - 1, 0, -1)])
