@@ -28,12 +28,13 @@ NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
 # No block partition at all yet: gmsh's quasi-structured quads stand in for the whole face.
-STAND_IN = {"perforated_plate"}
+STAND_IN = {"perforated_plate", "anc101_flange", "nist_ctc01_plate", "nist_ctc04_plate",
+            "bracket_plate"}
 # The stand-in itself is invalid there: inverted elements, or quads that do not tile.
 INVALID_STAND_IN = {"perforated_plate"}
 # Only the faces that are no blocks get unstructured quads; the other faces keep theirs.
 # Every face merged into one free face (no block left), filled by gmsh's frontal quads.
-ONE_FREE_FACE = {"engine_top", "bracket_plate"}
+ONE_FREE_FACE = {"engine_top"}
 # (tailwheel_gusset: all blocks, but 5 irregular vertices more than singular points)
 PARTLY_BLOCKS = NO_BLOCKS_YET - STAND_IN - ONE_FREE_FACE - {"tailwheel_gusset"}
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
@@ -106,8 +107,11 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 
 
 # housing_rib: free faces; io1_flange: full circles only (its pose once hung on a bore
-# concentric with the centroid); socket_bearing: blocks only.
-@pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing"])
+# concentric with the centroid); socket_bearing: blocks only; sketch_gasket: symmetric,
+# so round-off split its field's zeros differently in every pose until the field was
+# solved in the canonical pose.
+@pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
+                                  "sketch_gasket"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

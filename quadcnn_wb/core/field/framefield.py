@@ -12,6 +12,7 @@ point is a zero of the piecewise-linear z: a triangle around which arg z turns b
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -126,16 +127,50 @@ def triangle_windings(z: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return np.rint(total / (2 * np.pi)).astype(int)
 
 
-def compute_frame_field(mesh: BackgroundMesh) -> FrameField:
+POSE_DIGITS = 12  # unit-pose coordinates and tangents are rounded to this many decimals
+
+
+def compute_frame_field(mesh: BackgroundMesh, pose=None) -> FrameField:
+    """The field, solved in the part's canonical ``pose`` (input.pose) when one is given.
+
+    A part with symmetries has zeros of the field that its symmetry holds together; how
+    they part (one valence-3 point or three, which side first) is decided by round-off,
+    so the solve must see the same numbers for every turned, mirrored or moved copy:
+    the unit-pose coordinates, rounded.  z, the singular points and their directions are
+    then turned back into the part's frame."""
+    if pose is None:
+        return _field_here(mesh)
+    a = np.asarray(pose.matrix, dtype=float)  # input directions -> unit directions
+    posed = dataclasses.replace(
+        mesh, nodes=np.round(pose.to_unit(mesh.nodes), POSE_DIGITS) + 0.0,
+        boundary_tangent=np.round(mesh.boundary_tangent @ a.T, POSE_DIGITS) + 0.0,
+        corner_tangents_in=np.round(mesh.corner_tangents_in @ a.T, POSE_DIGITS) + 0.0,
+        # a mirror turns the triangles clockwise: back to counter-clockwise, so windings
+        # (and valences) keep their sign
+        triangles=mesh.triangles[:, ::-1] if pose.mirrored else mesh.triangles)
+    z_unit, singular = _zeros(posed)
+    turn = complex(a[0, 0], a[1, 0]) if not pose.mirrored else complex(-a[0, 0], a[1, 0])
+    z = (np.conj(z_unit) if pose.mirrored else z_unit) * np.conj(turn) ** 4
+    singularities = tuple(dataclasses.replace(
+        s, xy=pose.from_unit(s.xy), directions=s.directions @ a) for s in singular)
+    return FrameField(z=z, theta=np.angle(z) / 4.0, singularities=singularities,
+                      corner_sources=corner_sources(mesh))
+
+
+def _field_here(mesh: BackgroundMesh) -> FrameField:
+    z, singularities = _zeros(mesh)
+    return FrameField(z=z, theta=np.angle(z) / 4.0, singularities=singularities,
+                      corner_sources=corner_sources(mesh))
+
+
+def _zeros(mesh: BackgroundMesh) -> tuple:
+    """(z, singular points) on this mesh, in its own coordinates."""
     z = solve_cross_field(mesh)
-    theta = np.angle(z) / 4.0
     windings = triangle_windings(z, mesh.triangles)
     singular = np.nonzero(windings)[0]
     patches = _triangle_patches(mesh.triangles, singular)
-    singularities = tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
-                          for t, patch in zip(singular, patches))
-    return FrameField(z=z, theta=theta, singularities=singularities,
-                      corner_sources=corner_sources(mesh))
+    return z, tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
+                    for t, patch in zip(singular, patches))
 
 
 def _triangle_patches(triangles: np.ndarray, chosen: np.ndarray) -> list:

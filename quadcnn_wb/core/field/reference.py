@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..input.domain import Domain
+from ..input.pose import canonical_pose
 from ..layout.tracing import trace_streamlines
 from .background import BackgroundMesh, background_mesh
 from .framefield import FrameField, compute_frame_field
@@ -50,7 +51,7 @@ def background_and_field(domain: Domain, nodes: int, timings: dict,
         mesh = background_mesh(domain, nodes=nodes, strict=strict)
         timings["background"] = time.perf_counter() - clock
         clock = time.perf_counter()
-    field = compute_frame_field(mesh)
+    field = compute_frame_field(mesh, canonical_pose(domain))
     timings["field"] = time.perf_counter() - clock
     return mesh, field
 

@@ -215,8 +215,12 @@ def _without_zero_length(edges, h) -> list:
             a, b = b, a
         parent[b] = a
     dropped = set(short)
-    return [dataclasses.replace(edge, a=find(edge.a), b=find(edge.b))
-            for e, edge in enumerate(edges) if e not in dropped]
+    joined = [dataclasses.replace(edge, a=find(edge.a), b=find(edge.b))
+              for e, edge in enumerate(edges) if e not in dropped]
+    # A boundary stretch of no length between two places made one is a loop on one
+    # vertex now: it would give the vertex four boundary halves, and the face walk there
+    # would leave the domain (a whole face lost).
+    return [edge for edge in joined if edge.a != edge.b or edge.length > ZERO_LENGTH * h]
 
 
 DOUBLE_EDGE_GAP = 0.5  # two edges of the same ends closer than this (element sizes) are one
