@@ -34,6 +34,7 @@ from .partition_types import (
 )
 from .subdivide import split_odd_faces
 
+TURN_TIE = 1e-6  # radians: turns this close to CORNER_TURN are exactly at it
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
 
 
@@ -592,6 +593,11 @@ def _block_of(cycle, half, edges, vertices, h, head):
         turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
         turns.append(turn)
     turns = np.array(turns)
+    # A turn at the very threshold (a 45° chamfer met by a field line along one of its
+    # edges) is exactly CORNER_TURN, decided alike in every pose: neither a corner nor a
+    # turn back, not whichever side round-off put it on.
+    at_threshold = np.abs(np.abs(turns) - CORNER_TURN) <= TURN_TIE
+    turns = np.where(at_threshold, np.sign(turns) * CORNER_TURN, turns)
     outline = np.vstack([edges[e].points if f else edges[e].points[::-1]
                          for e, f in (half[c] for c in cycle)])
     tips = np.array([vertices[head(c)] for c in cycle])
