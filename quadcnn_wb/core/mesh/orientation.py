@@ -10,11 +10,16 @@ from __future__ import annotations
 import numpy as np
 
 
+def signed_areas(nodes: np.ndarray, quads: np.ndarray) -> np.ndarray:
+    """(Q,) shoelace area of each quad: positive when its corners run counter-clockwise."""
+    p = nodes[quads]
+    return 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
+                        - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
+
+
 def counter_clockwise_quads(nodes: np.ndarray, quads: np.ndarray) -> np.ndarray:
     """A copy of ``quads`` (Q, 4) with every clockwise quad's corners reversed."""
-    p = nodes[quads]
-    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1)
-                        - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1], axis=1)
+    area = signed_areas(nodes, quads)
     out = quads.copy()
     out[area < 0] = out[area < 0][:, ::-1]
     return out

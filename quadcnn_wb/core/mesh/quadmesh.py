@@ -20,7 +20,7 @@ from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_quads
-from .orientation import counter_clockwise_quads
+from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3
@@ -173,7 +173,7 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     xy = np.array(positions)
     interior, local = free_face_quads([xy[r] for r in rings], pose)
     points = np.vstack([xy[every], interior])
-    if _total_area(points, local) < 0:
+    if signed_areas(points, local).sum() < 0:
         local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
     if _sj_batch(points[local]).min() <= 0:
         points = _untangled(points, local, len(every))
@@ -220,23 +220,29 @@ def _untangled(points, local, n_ring) -> np.ndarray:
 
 
 def _laplacian(points, quads, fixed, iterations) -> np.ndarray:
-    edges = np.unique(np.sort(np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)]),
-                              axis=1), axis=0)
-    degree = np.bincount(edges.ravel(), minlength=len(points)).astype(float)
+    """Plain (unguarded) Laplacian moves of the nodes not fixed."""
+    edges, degree = _edge_graph(quads, len(points))
     free = ~fixed & (degree > 0)
     x = points.copy()
     for _ in range(iterations):
-        summed = np.zeros_like(x)
-        np.add.at(summed, edges[:, 0], x[edges[:, 1]])
-        np.add.at(summed, edges[:, 1], x[edges[:, 0]])
-        x[free] = summed[free] / degree[free, None]
+        x[free] = _neighbour_means(x, edges, degree)[free]
     return x
 
 
-def _total_area(points, quads) -> float:
-    p = points[quads]
-    return 0.5 * float(np.sum(p[..., 0] * np.roll(p[..., 1], -1, axis=-1)
-                              - np.roll(p[..., 0], -1, axis=-1) * p[..., 1]))
+def _edge_graph(quads, n: int) -> tuple:
+    """(unique quad edges (E, 2), number of edges at each of the n nodes)."""
+    edges = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    return edges, np.bincount(edges.ravel(), minlength=n).astype(float)
+
+
+def _neighbour_means(x, edges, degree) -> np.ndarray:
+    """Mean of each node's edge neighbours (rows of nodes on no edge are 0/0)."""
+    summed = np.zeros_like(x)
+    np.add.at(summed, edges[:, 0], x[edges[:, 1]])
+    np.add.at(summed, edges[:, 1], x[edges[:, 0]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return summed / degree[:, None]
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:
@@ -272,20 +278,14 @@ def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarr
     """Guarded Laplacian smoothing of the free nodes."""
     if not len(quads):
         return nodes
-    edges = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    n = len(nodes)
-    degree = np.bincount(edges.ravel(), minlength=n).astype(float)
+    edges, degree = _edge_graph(quads, len(nodes))
     free = ~fixed & (degree > 0)
     x = nodes.copy()
     span = float(np.ptp(x, axis=0).max())
     quality = scaled_jacobians(x, quads)
     for _ in range(iterations):
-        summed = np.zeros_like(x)
-        np.add.at(summed, edges[:, 0], x[edges[:, 1]])
-        np.add.at(summed, edges[:, 1], x[edges[:, 0]])
         proposal = x.copy()
-        proposal[free] = summed[free] / degree[free, None]
+        proposal[free] = _neighbour_means(x, edges, degree)[free]
         new_quality = scaled_jacobians(proposal, quads)
         # The margin keeps rounding noise from deciding (a turned copy must decide alike).
         bad = new_quality < np.minimum(quality, SMOOTH_FLOOR) - 1e-12
