@@ -481,11 +481,15 @@ def _around(items, half, edges, h) -> list:
             run.append(items[k + len(run)])
         if len(run) > 1:
             run.sort(key=lambda item, base=run[0][0]: tuple(
-                round(math.atan2(math.sin(farther(item[1], r) - base),
-                                 math.cos(farther(item[1], r) - base)), 9) for r in FARTHER))
+                round(_wrapped(farther(item[1], r) - base), 9) for r in FARTHER))
         out.extend(run)
         k += len(run)
     return out
+
+
+def _wrapped(angle: float) -> float:
+    """The angle in (-pi, pi]."""
+    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 def _faces_to_blocks(vertices, edges, h):
