@@ -73,6 +73,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     ends = [(s.start, s.end) for s in every]
     verts = _Vertices()
     tol = 1e-9 * domain.size
+    same_place = SAME_PLACE * element_size  # boundary ends this close along a loop are one
     # Split positions along each streamline: (arc-length position, vertex id).
     splits: list[list] = [[] for _ in lines]
     boundary_splits: dict = {li: set() for li in range(len(domain.loops))}
@@ -86,10 +87,11 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
         if start.kind == "singularity" and end.kind in ("boundary", "corner") \
                 and _length(pts) <= 1e-6 * element_size:
             verts.by_key.setdefault(("s", start.index), _end_vertex(
-                domain, verts, end, pts[-1], boundary_splits, k))
+                domain, verts, end, pts[-1], boundary_splits, k, same_place))
     for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
         for where, end_point, pos in ((start, pts[0], 0.0), (end, pts[-1], None)):
-            vid = _end_vertex(domain, verts, where, end_point, boundary_splits, k)
+            vid = _end_vertex(domain, verts, where, end_point, boundary_splits, k,
+                              same_place)
             if vid is None:
                 continue  # a T-junction end: resolved once the other line's vertices exist
             splits[k].append((pos if pos is not None else _length(pts), vid))
@@ -338,16 +340,47 @@ def _slits(free, edges) -> set:
     return out
 
 
-def _end_vertex(domain, verts, where, xy, boundary_splits, line_index):
+def _end_vertex(domain, verts, where, xy, boundary_splits, line_index, tol):
     if where.kind == "singularity":
         return verts.get(("s", where.index), xy)
     if where.kind in ("boundary", "corner"):
         key = _boundary_key(domain, where.loop, where.segment, where.param)
+        key = _split_already_there(domain, key, boundary_splits[key[1]], tol) or key
         boundary_splits[key[1]].add((key[2], key[3]))
         return verts.get(key, domain.loops[key[1]][key[2]].point(key[3]))
     if where.kind == "streamline":
         return None
     raise PartitionError(f"streamline {line_index} has an end of unknown kind {where.kind!r}")
+
+
+def _split_already_there(domain, key, taken, tol):
+    """The key of a boundary split already made within ``tol`` along the loop, if any.
+
+    Two traces ending a rounding error apart on the boundary (a separatrix and its
+    neighbour meeting a hole's rim at one point) otherwise left a boundary edge of no
+    length between two vertices in one place: faces walked it in no direction and a whole
+    hole ring came out as one point."""
+    _, li, seg, t = key
+    loop = domain.loops[li]
+    for other_seg, other_t in sorted(taken):
+        if _along(loop, (seg, t), (other_seg, other_t)) <= tol:
+            return ("b", li, other_seg, other_t)
+    return None
+
+
+def _along(loop, first, second) -> float:
+    """Distance along the loop between two (segment, parameter) places on the same or
+    neighbouring segments (the shorter way round); inf farther apart."""
+    (s1, t1), (s2, t2) = sorted((first, second))
+    n = len(loop)
+    if s1 == s2:
+        gap = abs(t2 - t1) * loop[s1].length
+        return min(gap, loop[s1].length - gap) if n == 1 else gap
+    if s2 == s1 + 1:
+        return (1.0 - t1) * loop[s1].length + t2 * loop[s2].length
+    if s1 == 0 and s2 == n - 1:
+        return (1.0 - t2) * loop[s2].length + t1 * loop[s1].length
+    return math.inf
 
 
 def _length(pts) -> float:
