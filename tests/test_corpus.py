@@ -28,7 +28,7 @@ NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
 # No block partition at all yet: gmsh's quasi-structured quads stand in for the whole face.
-STAND_IN = {"perforated_plate", "nist_ctc01_plate"}
+STAND_IN = {"perforated_plate"}
 # The stand-in itself is invalid there: inverted elements, or quads that do not tile.
 INVALID_STAND_IN = {"perforated_plate"}
 # Only the faces that are no blocks get unstructured quads; the other faces keep theirs.

@@ -43,6 +43,7 @@ def free_face_quads(rings, pose) -> tuple:
         order = np.arange(len(ring))
         if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
             order = np.concatenate([[0], np.arange(len(ring) - 1, 0, -1)])
+        order = np.roll(order, -_corner_parity(unit[order]))
         start = _start(unit[order])
         order = np.roll(order, -start)
         unit = unit[order]
@@ -107,6 +108,26 @@ def rings_are_simple(rings) -> bool:
             if np.any(np.hypot(*(u + t[:, None] * d - q).T) <= tol):
                 return False
     return True
+
+
+TURN_TIE = 1e-6  # radians: turns closer than this are equally sharp
+
+
+def _corner_parity(unit: np.ndarray) -> int:
+    """0 or 1: which every-other nodes of the ring gmsh gets at half resolution, so that
+    its sharpest turns are among them.  A sharp turn left to a middle node (a notch's
+    tip between two coarse nodes) is cut off by gmsh's chord, and the quads pulled out
+    to it fold.  Turns within TURN_TIE count as equal, and a tie keeps the ring's own
+    start, so round-off in a turned copy cannot flip the choice."""
+    before = unit - np.roll(unit, 1, axis=0)
+    after = np.roll(unit, -1, axis=0) - unit
+    turn = np.abs(np.arctan2(before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0],
+                             np.sum(before * after, axis=1)))
+    even, odd = (np.sort(turn[p::2])[::-1] for p in (0, 1))
+    for a, b in zip(even, odd):
+        if abs(a - b) > TURN_TIE:
+            return int(b > a)
+    return 0
 
 
 def _start(unit: np.ndarray) -> int:
