@@ -27,15 +27,10 @@ NO_BLOCKS_YET = {"anc101_flange", "housing_rib", "nist_ctc01_plate",
                  "engine_top", "motor_c_plate", "bracket_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
-# No block partition at all yet: gmsh's quasi-structured quads stand in for the whole face.
-STAND_IN = {"perforated_plate"}
-# The stand-in itself is invalid there: inverted elements, or quads that do not tile.
-INVALID_STAND_IN = {"perforated_plate"}
-# Only the faces that are no blocks get unstructured quads; the other faces keep theirs.
 # Every face merged into one free face (no block left), filled by gmsh's frontal quads.
-ONE_FREE_FACE = {"engine_top"}
+ONE_FREE_FACE = {"engine_top", "perforated_plate"}
 # (tailwheel_gusset: all blocks, but 5 irregular vertices more than singular points)
-PARTLY_BLOCKS = NO_BLOCKS_YET - STAND_IN - ONE_FREE_FACE - {"tailwheel_gusset"}
+PARTLY_BLOCKS = NO_BLOCKS_YET - ONE_FREE_FACE - {"tailwheel_gusset"}
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
 
@@ -69,8 +64,7 @@ def test_every_other_face_imports_as_delivered(name):
     assert domain.area > 0 and isinstance(domain.healed, tuple)
 
 
-@pytest.mark.parametrize("name", [expected_failure(n, INVALID_STAND_IN, "inverted stand-in")
-                                  for n in MESHABLE])
+@pytest.mark.parametrize("name", MESHABLE)
 def test_every_face_gets_a_valid_mesh(name):
     mesh = meshed(name).mesh
     assert meshed(name).quality["min_scaled_jacobian"] > 0
@@ -86,14 +80,27 @@ def test_every_face_is_block_structured(name):
     assert result.quality["irregular_vertices"] <= len(result.reference.field.singularities) + 4
 
 
-def test_a_face_without_blocks_says_so():
-    # While some faces still get no block partition, the stand-in must say so everywhere.
-    name = sorted(STAND_IN)[0]
-    result = meshed(name)
+def test_a_face_without_blocks_says_so(monkeypatch):
+    # No corpus face falls back as a whole any more; with no rebuild allowed, the free
+    # faces of bracket_plate that cannot be filled leave no block partition, and the
+    # quads that stand in (gmsh's, or the whole face as one free face where those fold)
+    # must say so everywhere.
+    from quadcnn_wb.core import pipeline
+
+    monkeypatch.setattr(pipeline, "FREEING_ROUNDS", 0)
+    result = mesh_domain(load_domain(CORPUS / PARTS["bracket_plate"]["file"]))
     assert not result.structured and "no block structure" in result.problem
+    assert "stand in" in result.problem and result.quality["min_scaled_jacobian"] > 0
     data = result.to_json()
     assert data["structured"] is False and data["structured_share"] == 0.0
     assert data["problem"] == result.problem
+
+
+@pytest.mark.parametrize("name", sorted(ONE_FREE_FACE))
+def test_a_face_merged_whole_is_one_free_face(name):
+    result = meshed(name)
+    assert not result.partition.blocks and len(result.partition.free_faces) == 1
+    assert result.structured_share == 0.0 and "unstructured quads there" in result.problem
 
 
 @pytest.mark.parametrize("name", sorted(PARTLY_BLOCKS))

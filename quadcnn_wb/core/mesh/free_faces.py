@@ -25,11 +25,18 @@ from ..layout.partition_types import PartitionError, fmt, inside_polygon
 KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 
 
-def free_face_quads(rings, pose) -> tuple:
+# gmsh's planar algorithm and recombination, tried in turn on a face whose quads stay
+# inverted (quadmesh.py): Frontal-Delaunay for quads with blossom first; on the faces of
+# the corpus that fold, each of the others fills a different share of them.
+FILL_METHODS = ((8, 1), (6, 0), (1, 1), (8, 0), (5, 1))
+
+
+def free_face_quads(rings, pose, method: int = 0) -> tuple:
     """(interior points (P, 2), quads (Q, 4)) filling the region bounded by ``rings``:
     the outer polygon (counter-clockwise) and the holes in it (clockwise), each of an
     even number of points, not repeated at the end.  Quads index the rings' points in
-    order (outer first) as 0 .. N-1 and the interior points as N .. N+P-1."""
+    order (outer first) as 0 .. N-1 and the interior points as N .. N+P-1.  ``method``
+    indexes FILL_METHODS."""
     rings = [np.asarray(r, dtype=float) for r in rings]
     centre = rings[0].mean(axis=0)
     if any(len(r) % 2 for r in rings) or len(rings[0]) < 6:
@@ -53,7 +60,7 @@ def free_face_quads(rings, pose) -> tuple:
     if not rings_are_simple([u[0::2] for u in units]):
         raise PartitionError(f"a free face near {fmt(centre)} touches or crosses itself: "
                              "no polygon to fill")
-    interior, quads = _gmsh_fill(units)
+    interior, quads = _gmsh_fill(units, *FILL_METHODS[method])
     order = np.concatenate(orders)
     quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
     return pose.from_unit(interior), quads
@@ -150,7 +157,7 @@ def _bends(a, middle, b) -> bool:
     return off > BEND_TOL * length
 
 
-def _gmsh_fill(units) -> tuple:
+def _gmsh_fill(units, algorithm: int, recombination: int) -> tuple:
     """gmsh's quads for the rings at half resolution; local ids as free_face_quads."""
     with gmsh_session() as session:
         geo = gmsh.model.geo
@@ -177,8 +184,8 @@ def _gmsh_fill(units) -> tuple:
         geo.synchronize()
         for line in line_of:
             gmsh.model.mesh.setTransfiniteCurve(line, 2)
-        for name, value in (("Mesh.Algorithm", 8), ("Mesh.RecombineAll", 1),
-                            ("Mesh.RecombinationAlgorithm", 1),
+        for name, value in (("Mesh.Algorithm", algorithm), ("Mesh.RecombineAll", 1),
+                            ("Mesh.RecombinationAlgorithm", recombination),
                             ("Mesh.SubdivisionAlgorithm", 1), ("Mesh.MeshSizeFromPoints", 1),
                             ("Mesh.MeshSizeFromCurvature", 0),
                             ("Mesh.MeshSizeExtendFromBoundary", 1)):

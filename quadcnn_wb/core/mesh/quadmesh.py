@@ -19,7 +19,7 @@ import numpy as np
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
-from .free_faces import free_face_quads
+from .free_faces import FILL_METHODS, free_face_quads
 from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
@@ -171,16 +171,27 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     if len(np.unique(every)) != len(every):
         raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
     xy = np.array(positions)
-    interior, local = free_face_quads([xy[r] for r in rings], pose)
-    points = np.vstack([xy[every], interior])
-    if signed_areas(points, local).sum() < 0:
-        local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
-    if _sj_batch(points[local]).min() <= 0:
-        points = _untangled(points, local, len(every))
+    # gmsh places its nodes for the straightened outline; where the neighbours' side
+    # nodes bend it so far that no moving of them unfolds the quads, another of gmsh's
+    # algorithms often lays them out so that it does.
+    for method in range(len(FILL_METHODS)):
+        try:
+            interior, local = free_face_quads([xy[r] for r in rings], pose, method)
+        except PartitionError:
+            if method == 0:
+                raise
+            continue
+        points = np.vstack([xy[every], interior])
+        if signed_areas(points, local).sum() < 0:
+            local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
         if _sj_batch(points[local]).min() <= 0:
-            raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
-                                 "curved sides")
-        interior = points[len(every):]
+            points = _untangled(points, local, len(every))
+        if _sj_batch(points[local]).min() > 0:
+            break
+    else:
+        raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
+                             "curved sides")
+    interior = points[len(every):]
     first = len(positions)
     positions.extend(interior)
     return np.where(local < len(every), every[np.minimum(local, len(every) - 1)],
