@@ -192,3 +192,57 @@ def test_overlapping_blocks_are_detected():
     stacked = np.array([[0, 1, 2, 3], [1, 4, 5, 2], [0, 1, 2, 3]])  # one quad twice
     assert tiles_exactly(nodes, side_by_side)
     assert not tiles_exactly(nodes, stacked)  # every corner is fine, the cover is not
+
+
+def test_two_traces_ending_a_rounding_error_apart_on_a_rim_share_one_vertex():
+    # They once left a boundary edge of no length between two vertices in one place, and
+    # the hole's ring of a face came out as one point (bracket_plate, nist_ctc04_plate).
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.partition import build_partition
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    domain = domain_from_json({"loops": [
+        [{"line": [[0, 0], [2, 0]]}, {"line": [[2, 0], [2, 1]]}, {"line": [[2, 1], [0, 1]]},
+         {"line": [[0, 1], [0, 0]]}],
+        [{"circle": {"center": [1, 0.5], "radius": 0.25}}]]})
+    rim = domain.loops[1][0]
+    h = 0.05
+    lines = []
+    for start, start_seg, tip in (((0.0, 0.5), 3, (0.75, 0.5)),
+                                  ((0.75, 1.0), 2, (0.75, 0.5 + 1e-10))):
+        t_rim = float(rim.project(np.array(tip)))
+        t_outer = float(domain.loops[0][start_seg].project(np.array(start)))
+        points = np.linspace(start, rim.point(t_rim), 20)
+        lines.append(Streamline(points, Endpoint("boundary", loop=0, segment=start_seg,
+                                                 param=t_outer),
+                                Endpoint("boundary", loop=1, segment=0, param=t_rim)))
+    partition = build_partition(domain, lines, h)
+    rim_vertices = {v for edge in partition.edges if edge.is_boundary
+                    and edge.pieces[0].loop == 1 for v in (edge.a, edge.b)}
+    assert len(rim_vertices) == 1
+    assert min(edge.length for edge in partition.edges) > 1e-6 * h
+
+
+@pytest.mark.parametrize("shift", [0, 1])
+def test_a_free_face_keeps_a_notch_tip_among_gmsh_nodes(shift):
+    # gmsh meshes every other side node; a notch's tip left between two of them was cut
+    # off by its chord, and the quads pulled out to the tip folded (nist_ctc01_plate).
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.pose import canonical_pose
+    from quadcnn_wb.core.mesh.free_faces import free_face_quads
+    from quadcnn_wb.core.mesh.orientation import signed_areas
+    from quadcnn_wb.core.mesh.quadmesh import scaled_jacobians
+
+    steps = np.arange(0, 4, 0.5)
+    ring = np.array([(x, 0.0) for x in steps] + [(4.0, y) for y in steps[:4]]
+                    + [(4 - x, 2.0 if x != 2 else 0.9) for x in steps]
+                    + [(0.0, 2 - y) for y in steps[:4]])
+    ring = np.roll(ring, -shift, axis=0)  # the tip at an even, then an odd place
+    domain = domain_from_json({"loops": [[
+        {"line": [[0, 0], [4, 0]]}, {"line": [[4, 0], [4, 2]]}, {"line": [[4, 2], [0, 2]]},
+        {"line": [[0, 2], [0, 0]]}]]})
+    interior, quads = free_face_quads([ring], canonical_pose(domain))
+    points = np.vstack([ring, interior])
+    if signed_areas(points, quads).sum() < 0:
+        quads = quads[:, ::-1]
+    assert scaled_jacobians(points, quads).min() > 0.2
