@@ -31,12 +31,14 @@ KEY_DIGITS = 7  # rounding of the keys that choose where the outline starts
 FILL_METHODS = ((8, 1), (6, 0), (1, 1), (8, 0), (5, 1))
 
 
-def free_face_quads(rings, pose, method: int = 0) -> tuple:
-    """(interior points (P, 2), quads (Q, 4)) filling the region bounded by ``rings``:
+def free_face_fills(rings, pose):
+    """Fills of the region bounded by ``rings``, one per FILL_METHODS entry, each
+    (interior points (P, 2), quads (Q, 4)); the outline is checked and put in the
+    canonical pose once for all of them.  ``rings``:
     the outer polygon (counter-clockwise) and the holes in it (clockwise), each of an
     even number of points, not repeated at the end.  Quads index the rings' points in
-    order (outer first) as 0 .. N-1 and the interior points as N .. N+P-1.  ``method``
-    indexes FILL_METHODS."""
+    order (outer first) as 0 .. N-1 and the interior points as N .. N+P-1.  The first
+    method's failure is raised; a later one that fails is skipped."""
     rings = [np.asarray(r, dtype=float) for r in rings]
     centre = rings[0].mean(axis=0)
     if any(len(r) % 2 for r in rings) or len(rings[0]) < 6:
@@ -60,10 +62,23 @@ def free_face_quads(rings, pose, method: int = 0) -> tuple:
     if not rings_are_simple([u[0::2] for u in units]):
         raise PartitionError(f"a free face near {fmt(centre)} touches or crosses itself: "
                              "no polygon to fill")
-    interior, quads = _gmsh_fill(units, *FILL_METHODS[method])
     order = np.concatenate(orders)
-    quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
-    return pose.from_unit(interior), quads
+    for method, (algorithm, recombination) in enumerate(FILL_METHODS):
+        try:
+            interior, quads = _gmsh_fill(units, algorithm, recombination)
+        except PartitionError:
+            if method == 0:
+                raise
+            continue
+        quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
+        yield pose.from_unit(interior), quads
+
+
+def free_face_quads(rings, pose) -> tuple:
+    """The first of free_face_fills: gmsh's default algorithm."""
+    return next(free_face_fills(rings, pose))
+
+
 
 
 SIMPLE_TOL = 1e-6  # share of the polygon's size: closer than this is touching

@@ -19,7 +19,7 @@ import numpy as np
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
-from .free_faces import FILL_METHODS, free_face_quads
+from .free_faces import free_face_fills
 from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
@@ -174,13 +174,7 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     # gmsh places its nodes for the straightened outline; where the neighbours' side
     # nodes bend it so far that no moving of them unfolds the quads, another of gmsh's
     # algorithms often lays them out so that it does.
-    for method in range(len(FILL_METHODS)):
-        try:
-            interior, local = free_face_quads([xy[r] for r in rings], pose, method)
-        except PartitionError:
-            if method == 0:
-                raise
-            continue
+    for interior, local in free_face_fills([xy[r] for r in rings], pose):
         points = np.vstack([xy[every], interior])
         if signed_areas(points, local).sum() < 0:
             local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
