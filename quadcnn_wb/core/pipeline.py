@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .field.pairs import without_cancelling_pairs
 from .field.reference import Reference, background_and_field
 from .input.domain import Domain
 from .input.pose import diameter
@@ -105,6 +106,9 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     # The cnn path needs the node count its network was trained for; tracing does not.
     background, field = background_and_field(domain, nodes, timings,
                                              strict=method == "cnn")
+    # Pairs of singular points that cancel are no structure (field.pairs): the layout
+    # (and the result's singular points) is made from the others.
+    field = without_cancelling_pairs(field, background.element_size)
     clock = time.perf_counter()
     if method == "cnn":
         lines, _ = learned_streamlines(domain, background, field)
@@ -137,12 +141,17 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
         clock = time.perf_counter()
         mesh = gmsh_quad_mesh(domain, size)
         timings["quad_mesh"] = time.perf_counter() - clock
-        if not is_valid_mesh(mesh):
+        if not is_valid_mesh(mesh) and isinstance(exc, PoorMesh):
+            # gmsh's own quads fold here: our poor but unfolded mesh is the better one.
+            cuts, partition, counts, mesh = exc.result
+            problem = f"{free_face_problem(partition) or 'blocks'}, worst scaled Jacobian " \
+                      f"{exc.worst:.3f}: gmsh's own quads fold here"
+        elif not is_valid_mesh(mesh):
             # gmsh's own quads fold here: the domain as one free face stands in instead.
             clock = time.perf_counter()
             try:
                 cuts, partition, counts, mesh = blocks_and_mesh(
-                    domain, background, field, (), size, smoothing, {})
+                    domain, background, field, (), size, smoothing, {}, worst_allowed=0.0)
                 problem = f"no block structure ({exc}); unstructured quads stand in"
             except PartitionError:
                 pass  # nothing better to be had: gmsh's mesh as it is
@@ -169,13 +178,14 @@ FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable f
 
 
 def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
-                    allow_free=True):
+                    allow_free=True, worst_allowed=MIN_VALID_JACOBIAN):
     """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
     can be had from these streamlines.  Faces that are no blocks, and blocks whose map
     gives a degenerate element, get unstructured quads (free faces); a free face that
     cannot be filled (it pinches or touches itself) loses its streamline edges, merging
     it with its neighbours, and the partition is built again.  Not when ``allow_free`` is
-    False (the cnn path: its lines are then not trusted)."""
+    False (the cnn path: its lines are then not trusted).  ``worst_allowed``: the scaled
+    Jacobian a mesh must beat (lower only where the alternative is a folded mesh)."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
     dissolve, freed = frozenset(), set()
     clock = time.perf_counter()
@@ -226,7 +236,12 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         freed |= folded
         dissolve = dissolve | merged
     worst = sj.min() if len(sj) else 0.0
-    if worst <= MIN_VALID_JACOBIAN:
+    checks_pass = tiles_exactly(mesh.nodes, mesh.quads) \
+        and free_edges_on_boundary(mesh.quads, mesh.boundary) \
+        and boundary_on_free_edges(mesh.quads, mesh.boundary)
+    if 0.0 < worst <= worst_allowed and checks_pass:
+        raise PoorMesh(worst, (cuts, partition, counts, mesh))
+    if worst <= worst_allowed:
         raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
                              f"{worst:.3f})")
     if not tiles_exactly(mesh.nodes, mesh.quads):
@@ -236,6 +251,17 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     if not boundary_on_free_edges(mesh.quads, mesh.boundary):
         raise PartitionError("the quads cover a hole")
     return cuts, partition, counts, mesh
+
+
+class PoorMesh(PartitionError):
+    """A valid mesh (no element folds) whose worst element is below MIN_VALID_JACOBIAN:
+    not handed out while gmsh's own quads are better, kept for where they fold."""
+
+    def __init__(self, worst: float, result: tuple):
+        super().__init__(f"the block maps give a degenerate element (scaled Jacobian "
+                         f"{worst:.3f})")
+        self.worst = worst
+        self.result = result
 
 
 def _block_key(partition: Partition, b: int) -> frozenset:

@@ -27,6 +27,7 @@ MAX_LENGTH = 4.0  # streamlines longer than this many domain diagonals are cappe
 ROUND_TRIP = 3.0  # a line may end on its own source once it went this many SNAP radii
 SNAP_CANDIDATES = 3  # a line is tested against this many nearest targets, nearest first
 MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
+ARRIVAL_BLEND = 3.0  # an arriving line's last stretch (sizes) is bent onto the separatrix
 
 
 # ----------------------------------------------------------------------------------------
@@ -163,7 +164,7 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
     def slot(e):
         return (e.kind, e.index, e.branch) if e.branch >= 0 else None
 
-    lines = _arrival_branches(lines, h)
+    lines = _along_own_separatrices(_arrival_branches(lines, h), h)
     final, joins = claim_separatrices([line.length for line in lines],
                                       [slot(line.start) for line in lines],
                                       [slot(line.end) for line in lines])
@@ -205,6 +206,70 @@ def _arrival_branches(lines, h):
                 best, best_dist = branch, d
         out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
     return out
+
+
+def _along_own_separatrices(lines, h):
+    """Arriving lines whose last stretch is bent onto the separatrix they arrive along.
+
+    A line snaps onto a point from up to SNAP sizes away, beside the separatrix rather
+    than on it, and its last step then ran straight at the point with a kink of up to a
+    right angle; the faces on either side measured their turn at the point from that
+    kink, not from the separatrix, and one of them lost (or gained) a corner.  Over its
+    last ARRIVAL_BLEND sizes the line is blended into the point's own trace of that
+    separatrix (matched by distance from the point, weights rising smoothly to one at
+    the point), so it arrives along it, as a streamline into a singular point does."""
+    leaving = {(ln.start.kind, ln.start.index, ln.start.branch): ln for ln in lines}
+    out = []
+    for line in lines:
+        own = leaving.get((line.end.kind, line.end.index, line.end.branch))
+        if own is None or own is line or line.end.branch < 0 \
+                or not _leave_alike(line.points[::-1], own.points, h):
+            out.append(line)  # no such trace, or one off to another side: left as it is
+            continue
+        out.append(dataclasses.replace(line, points=_blended_tail(line.points, own.points,
+                                                                  ARRIVAL_BLEND * h)))
+    return out
+
+
+ALIKE = math.cos(math.radians(60))  # two lines leaving a point this close run alike
+ALIKE_REACH = 2.0  # ... seen this many sizes out
+
+
+def _leave_alike(first, second, h) -> bool:
+    """Whether two polylines leaving one point head the same way, seen from the point
+    ALIKE_REACH sizes out (or two thirds of their length): a line is bent onto a
+    separatrix only when it comes in beside it, never round to another side of the
+    point.  Farther out than the snap's last step, whose kink points anywhere."""
+    def heading(points):
+        cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+        reach = min(ALIKE_REACH * h, 2.0 * cum[-1] / 3.0)
+        d = np.array([np.interp(reach, cum, points[:, 0]),
+                      np.interp(reach, cum, points[:, 1])]) - points[0]
+        n = float(np.hypot(*d))
+        return d / n if n > 0 else d
+
+    return float(heading(first) @ heading(second)) >= ALIKE
+
+
+def _blended_tail(points, own, reach):
+    """``points`` (ending at own[0]) with the last ``reach`` of it moved onto ``own``.
+
+    Every point moves by its own weight, a smooth function of its distance along the
+    line to the end (zero beyond ``reach``): no point is picked by an index, so a turned
+    or moved copy of the part gets the same line to round-off."""
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    own_cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(own, axis=0).T))])
+    reach = min(reach, 0.5 * float(cum[-1]), 0.5 * float(own_cum[-1]))
+    if reach <= 0:
+        return points
+    from_end = cum[-1] - cum  # distance along the line to the point
+    target = np.column_stack([np.interp(from_end, own_cum, own[:, 0]),
+                              np.interp(from_end, own_cum, own[:, 1])])
+    x = np.clip(1.0 - from_end / reach, 0.0, 1.0)
+    w = (x * x * (3.0 - 2.0 * x))[:, None]
+    moved = (1.0 - w) * points + w * target
+    moved[-1] = points[-1]
+    return moved
 
 
 def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
