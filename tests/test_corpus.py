@@ -28,7 +28,7 @@ NO_BLOCKS_YET = {"anc101_flange", "nist_ctc01_plate",
                  "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
 # Every face merged into free faces (no block left), filled by gmsh's frontal quads.
-NO_BLOCK_LEFT = {"engine_top", "perforated_plate", "bracket_plate"}
+NO_BLOCK_LEFT = {"perforated_plate"}
 PARTLY_BLOCKS = NO_BLOCKS_YET - NO_BLOCK_LEFT
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 

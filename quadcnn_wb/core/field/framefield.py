@@ -236,14 +236,22 @@ def _inside_triangle(p, corners, tol=1e-12) -> bool:
 
 
 def _clamp_into_triangle(p, corners):
-    a, b, c = corners
-    m = np.array([b - a, c - a]).T
-    u, v = np.linalg.lstsq(m, p - a, rcond=None)[0]
-    u, v = max(u, 0.0), max(v, 0.0)
-    s = u + v
-    if s > 1:
-        u, v = u / s, v / s
-    return a + u * (b - a) + v * (c - a)
+    """The triangle's point nearest to p (p lies outside it).
+
+    The nearest point, not a clipping of barycentric coordinates: those are measured
+    from one corner, and a mirrored copy of the part, whose triangles list their corners
+    the other way round, got its singular point elsewhere (up to a third of an element
+    away on sketch_bracket), and its whole layout with it."""
+    best, best_d = None, np.inf
+    for k in range(3):
+        a, b = corners[k], corners[(k + 1) % 3]
+        d = b - a
+        t = float(np.clip((p - a) @ d / max(float(d @ d), 1e-300), 0.0, 1.0))
+        q = a + t * d
+        dist = float(np.hypot(*(p - q)))
+        if dist < best_d:
+            best, best_d = q, dist
+    return best
 
 
 def separatrix_directions(zx: complex, zy: complex, valence: int) -> np.ndarray:

@@ -129,7 +129,8 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
             break
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
 
-    vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain)
+    vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
+                                             unsplit=dissolve)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
     used = {v for edge in edges for v in (edge.a, edge.b)}
     singular = tuple(sorted(singular & used))

@@ -26,9 +26,18 @@ from .partition_types import (
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
 
-def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain):
+def split_key(vertices, corners) -> tuple:
+    """The name of an odd face's split (its spokes' origin): its corner places, which a
+    rebuild of the same input repeats exactly."""
+    return ("split", frozenset(tuple(np.asarray(vertices[c]).tolist()) for c in corners))
+
+
+def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain,
+                    unsplit=frozenset()):
     """(vertex list, blocks, free faces): four-cornered faces as they are, others
-    subdivided; free faces follow the edges split on their way."""
+    subdivided; free faces follow the edges split on their way.  A face whose split is
+    in ``unsplit`` (its blocks became a free face that could not be filled: the spokes
+    are what a rebuild can take away) stays whole, a free face."""
     vertices = list(vertices)
     odd = [f for f in faces if len(f[0]) != 4]
     blocks = []
@@ -41,11 +50,13 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
     for (corners, sides), mids in zip(odd, all_mids):
         centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
         polygon = np.array([vertices[c] for c in corners])
-        if not inside_polygon(polygon, centre):
+        key = split_key(vertices, corners)
+        if key in unsplit or not inside_polygon(polygon, centre):
             halves = [h for side in sides for h in side]
+            why = "whose split could not be filled" if key in unsplit \
+                else "is too concave to split into quadrilaterals"
             free_halves.append((halves, f"a {len(corners)}-cornered block near "
-                                f"{fmt(centre)} is too concave to split into "
-                                "quadrilaterals"))
+                                f"{fmt(centre)} {why}"))
             everything.append((None, [halves]))
             continue
         c_id = len(vertices)
@@ -54,7 +65,7 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
         for m in mids:
             pts = np.linspace(centre, vertices[m], 8)
             spokes.append(len(edges))
-            edges.append(Edge(points=pts, a=c_id, b=m))
+            edges.append(Edge(points=pts, a=c_id, b=m, origin=key))
         k = len(corners)
         for j in range(k):
             first_half = sides[j][: _mid_index(sides[j], edges, mids[j]) + 1]

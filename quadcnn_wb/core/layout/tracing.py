@@ -34,6 +34,7 @@ from .streamlines import Endpoint, Streamline
 
 STEP = 0.25  # integration step, in element sizes
 CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the corner
+STRAIGHT_START = 0.75  # sizes a separatrix runs straight from its singular point
 
 
 class _BoundaryIndex:
@@ -107,6 +108,8 @@ def trace_streamlines(domain: Domain, mesh: BackgroundMesh, field_: FrameField) 
 
 def integrate(domain, mesh, field_, sources, walker=None) -> list:
     """Trace from each (start xy, unit direction, start triangle, start Endpoint) source."""
+    if not len(sources):
+        return []
     h = mesh.element_size
     step = STEP * h
     walker = walker or mesh.walker
@@ -120,12 +123,19 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
     targets, target_kind = snap_targets(mesh, field_)
     max_steps = int(MAX_LENGTH * domain.size / step) + 2
 
-    pos = starts + step * dirs
+    # A separatrix leaves its singular point straight along its direction for the first
+    # STRAIGHT_START sizes: there the field is its linear model, whose separatrices are
+    # rays, while the nodal crosses beside a zero are the noisiest of the field (a trace
+    # stepped by them from the start could swing to the neighbouring separatrix's arm
+    # and run beside it).
+    first = np.array([STRAIGHT_START * h if s[3].kind == "singularity" else step
+                      for s in sources]).reshape(-1)
+    pos = starts + first[:, None] * dirs
     tri, bary, exit_edge = walker.locate(tri0, pos)
     paths = [[starts[i].copy(), pos[i].copy()] for i in range(len(sources))]
     ends: list = [None] * len(sources)
     capped = [False] * len(sources)
-    travelled = np.full(len(sources), step)
+    travelled = first.copy()
     active = np.arange(len(sources))
     # Sources whose first step already leaves the domain end there.
     active = _finish_exits(active, tri, exit_edge, starts[active], pos, paths, ends, mesh,

@@ -44,7 +44,7 @@ def free_face_fills(rings, pose):
     if any(len(r) % 2 for r in rings) or len(rings[0]) < 6:
         raise PartitionError(f"a free face near {fmt(centre)} has {len(rings[0])} side "
                              "segments (an even number >= 6 is needed)")
-    units, orders, offset = [], [], 0
+    posed = []  # per ring: its unit-pose points in walking order, their parity
     for ring in rings:
         # Rounded as the background's geometry is: a turned copy hands gmsh the very same
         # numbers, not numbers a rounding error apart (which changed the quads).
@@ -52,16 +52,12 @@ def free_face_fills(rings, pose):
         order = np.arange(len(ring))
         if pose.mirrored:  # the canonical pose of a mirror image runs the other way round
             order = np.concatenate([[0], np.arange(len(ring) - 1, 0, -1)])
-        order = np.roll(order, -_corner_parity(unit[order]))
-        start = _start(unit[order])
-        order = np.roll(order, -start)
-        unit = unit[order]
-        units.append(unit)
-        orders.append(order + offset)
-        offset += len(ring)
-    if not rings_are_simple([u[0::2] for u in units]):
+        posed.append((unit, order, _corner_parity(unit[order])))
+    units, orders = _simple_half_rings(posed)
+    if units is None:
         raise PartitionError(f"a free face near {fmt(centre)} touches or crosses itself: "
                              "no polygon to fill")
+    offset = sum(len(r) for r in rings)
     order = np.concatenate(orders)
     for method, (algorithm, recombination) in enumerate(FILL_METHODS):
         try:
@@ -72,6 +68,27 @@ def free_face_fills(rings, pose):
             continue
         quads = np.where(quads < offset, order[np.minimum(quads, offset - 1)], quads)
         yield pose.from_unit(interior), quads
+
+
+def _simple_half_rings(posed) -> tuple:
+    """(unit rings, index orders) of the first choice of every-other nodes whose coarse
+    rings gmsh can mesh, or (None, None): the sharpest-turn parity of every ring first,
+    then each ring's other parity, then all of them flipped.  In a thin curved strip
+    (a gear's tooth gap) one parity's chords cross the other side where the other's
+    do not."""
+    n = len(posed)
+    flips = [()] + [(k,) for k in range(n)] + ([tuple(range(n))] if n > 1 else [])
+    for flipped in flips:
+        units, orders, offset = [], [], 0
+        for k, (unit, order, parity) in enumerate(posed):
+            order = np.roll(order, -(1 - parity if k in flipped else parity))
+            order = np.roll(order, -_start(unit[order]))
+            units.append(unit[order])
+            orders.append(order + offset)
+            offset += len(unit)
+        if rings_are_simple([u[0::2] for u in units]):
+            return units, orders
+    return None, None
 
 
 def free_face_quads(rings, pose) -> tuple:
