@@ -107,3 +107,25 @@ def test_field_is_deterministic():
     (_, f1), (_, f2) = field_of(domain), field_of(domain)
     assert np.array_equal(f1.z, f2.z)
     assert [s.xy.tolist() for s in f1.singularities] == [s.xy.tolist() for s in f2.singularities]
+
+
+def test_a_zero_outside_its_triangle_goes_to_the_nearest_point_whatever_the_corner_order():
+    # The clamp used to clip barycentric coordinates measured from the first corner: a
+    # mirrored copy, whose triangles list their corners the other way round, got its
+    # singular point up to a third of an element elsewhere (sketch_bracket).
+    from itertools import permutations
+
+    from quadcnn_wb.core.field.framefield import _clamp_into_triangle
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        corners = rng.uniform(-1, 1, (3, 2))
+        p = rng.uniform(-3, 3, 2)
+        places = [_clamp_into_triangle(p, corners[list(order)])
+                  for order in permutations(range(3))]
+        assert all(np.allclose(q, places[0], atol=1e-12) for q in places)
+        u, v = rng.uniform(0, 1, (2, 400))
+        u, v = np.where(u + v > 1, 1 - u, u), np.where(u + v > 1, 1 - v, v)
+        inside = corners[0] + np.outer(u, corners[1] - corners[0]) \
+            + np.outer(v, corners[2] - corners[0])
+        assert np.hypot(*(p - places[0])) <= np.hypot(*(inside - p).T).min() + 1e-12

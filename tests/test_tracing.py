@@ -179,3 +179,36 @@ def test_a_line_ending_on_a_singular_point_arrives_along_a_separatrix(name):
             if line.end.kind == "singularity":
                 worst = max(worst, _arrival_angle(ref, line))
     assert worst < 20.0
+
+
+def _closest_pair_of_separatrices(ref, reach: float) -> float:
+    """Over every singular point, the smallest distance (element sizes) between two of
+    its separatrix traces, each taken where it is ``reach`` sizes from its start."""
+    h = ref.mesh.element_size
+    heads: dict = {}
+    for line in ref.streamlines:
+        for end, pts in ((line.start, line.points), (line.end, line.points[::-1])):
+            if end.kind != "singularity":
+                continue
+            cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+            if cum[-1] < reach * h:
+                continue
+            p = np.array([np.interp(reach * h, cum, pts[:, 0]),
+                          np.interp(reach * h, cum, pts[:, 1])])
+            heads.setdefault(end.index, []).append(p)
+    gaps = [np.hypot(*(a - b)) / h for ps in heads.values()
+            for i, a in enumerate(ps) for b in ps[i + 1:]]
+    return min(gaps)
+
+
+def test_separatrices_of_one_singular_point_do_not_run_side_by_side():
+    # sketch_bracket: stepped by the nodal crosses from its first quarter element, the
+    # eastward separatrix of a valence-5 point by a bore swung north within a step and
+    # ran a fifth of an element beside the northward one (a three-cornered sliver, and a
+    # different layout in the mirror image).  Separatrices now leave straight along the
+    # field's linear model for the first STRAIGHT_START sizes.
+    from pathlib import Path
+
+    domain = load_domain(Path(__file__).parent / "corpus" / "sketch_bracket.brep")
+    assert _closest_pair_of_separatrices(numerical_reference(domain, labels=False),
+                                         1.5) > 0.5
