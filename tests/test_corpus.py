@@ -160,3 +160,21 @@ def test_every_part_is_accepted_in_every_pose(name):
         moved = transform_domain_json(data, similarity(degrees, scale, mirror),
                                       np.full(2, shift * domain.size * scale))
         assert len(domain_from_json(moved).loops) == len(domain.loops), (degrees, shift)
+
+
+def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(monkeypatch):
+    # bracket_plate: on 2048 background nodes the field does not resolve its slots' ends
+    # (singular points a fraction of an element from them, no block left); on four times
+    # as many the whole face is blocks, irregular only at its singular points.
+    from quadcnn_wb.core import pipeline
+
+    domain = load_domain(CORPUS / PARTS["bracket_plate"]["file"])
+    monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
+    coarse = mesh_domain(domain)
+    assert coarse.structured_share < 1.0
+    monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 4)
+    finer = mesh_domain(domain)
+    assert finer.structured_share == 1.0, finer.problem
+    assert finer.reference.mesh.n_nodes > 3 * coarse.reference.mesh.n_nodes
+    assert finer.quality["irregular_vertices"] <= len(finer.reference.field.singularities)
+    assert finer.timings["total"] >= finer.timings["other_background"] > 0
