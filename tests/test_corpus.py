@@ -22,14 +22,10 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # No block partition yet (issue 15's T-mesh partition and quantization): gmsh stands in.
-NO_BLOCKS_YET = {"anc101_flange", "nist_ctc01_plate",
-                 "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
-                 "engine_top", "motor_c_plate", "bracket_plate",
-                 "perforated_plate", "sketch_slot_plate", "sketch_keyhole_plate",
+NO_BLOCKS_YET = {"nist_ctc01_plate", "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
+                 "engine_top", "motor_c_plate", "perforated_plate", "sketch_keyhole_plate",
                  "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
-# Every face merged into free faces (no block left), filled by gmsh's frontal quads.
-NO_BLOCK_LEFT = {"perforated_plate"}
-PARTLY_BLOCKS = NO_BLOCKS_YET - NO_BLOCK_LEFT
+PARTLY_BLOCKS = NO_BLOCKS_YET
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
 
@@ -81,25 +77,19 @@ def test_every_face_is_block_structured(name):
 
 def test_a_face_without_blocks_says_so(monkeypatch):
     # No corpus face falls back as a whole any more; with no rebuild allowed, the free
-    # faces of bracket_plate that cannot be filled leave no block partition, and the
-    # quads that stand in (gmsh's, or the whole face as one free face where those fold)
-    # must say so everywhere.
+    # faces of bracket_plate that cannot be filled on the 2048-node background (and no
+    # finer one allowed) leave no block partition, and the quads that stand in (gmsh's,
+    # or the whole face as one free face where those fold) must say so everywhere.
     from quadcnn_wb.core import pipeline
 
     monkeypatch.setattr(pipeline, "FREEING_ROUNDS", 0)
+    monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
     result = mesh_domain(load_domain(CORPUS / PARTS["bracket_plate"]["file"]))
     assert not result.structured and "no block structure" in result.problem
     assert "stand in" in result.problem and result.quality["min_scaled_jacobian"] > 0
     data = result.to_json()
     assert data["structured"] is False and data["structured_share"] == 0.0
     assert data["problem"] == result.problem
-
-
-@pytest.mark.parametrize("name", sorted(NO_BLOCK_LEFT))
-def test_a_face_merged_whole_is_free_faces_only(name):
-    result = meshed(name)
-    assert not result.partition.blocks and result.partition.free_faces
-    assert result.structured_share == 0.0 and "unstructured quads there" in result.problem
 
 
 @pytest.mark.parametrize("name", sorted(PARTLY_BLOCKS))
