@@ -207,8 +207,10 @@ def _run_mesh(args) -> None:
     png = _check_output(args.png, {".png"})
     domain = load_domain(args.input)
     source, method = _streamline_source(args, domain)
+    limit = getattr(args, "time_limit", None)
     result = mesh_domain(domain, size=args.size, nodes=args.nodes, method=method,
-                         learned_streamlines=source)
+                         learned_streamlines=source,
+                         seconds=0.8 * limit if limit else None)
     if out:
         export(result, out)
     if png:

@@ -84,7 +84,7 @@ def default_size(domain: Domain) -> float:
 
 def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
                 method: str = "numerical", smoothing: bool = True,
-                learned_streamlines=None) -> MeshResult:
+                learned_streamlines=None, seconds: float | None = None) -> MeshResult:
     """Domain to quad mesh.
 
     method "numerical" traces the streamlines; "cnn" takes them from
@@ -92,6 +92,8 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     infer.cnn; core itself never imports onnxruntime), and if those do not cut the domain
     into four-sided blocks, every streamline is traced numerically instead, so every valid
     input still gets a valid mesh.  "auto" is "cnn" when a learned source is given.
+    ``seconds``: the time the caller allows (the command line's --time-limit); the
+    second layout on a finer background is tried only when it should fit in it.
     """
     if method not in ("numerical", "auto", "cnn"):
         raise ValueError(f"unknown method {method!r} (auto, cnn or numerical)")
@@ -105,6 +107,8 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     result = _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines)
     if method != "numerical" or result.structured_share >= 1.0 or FINER_BACKGROUND <= 1:
         return result
+    if seconds is not None and (1.0 + FINER_COST) * result.timings["total"] > seconds:
+        return result  # no time for it: a mesh now beats a better one past the limit
     # Free faces left: the field may not resolve the part's small features (a gear's
     # roots, bolt holes of a few elements, notches) on `nodes` background nodes.  The
     # layout on a finer background is tried too, and the better mesh kept: more of it in
@@ -119,6 +123,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
 
 
 FINER_BACKGROUND = 4  # times the background nodes of the second try where free faces are left
+FINER_COST = 2.0  # the second try's time, at most about this many times the first's
 
 
 def _better(first: MeshResult, second: MeshResult) -> bool:
