@@ -269,14 +269,12 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         freed |= folded
         dissolve = dissolve | merged
     worst = sj.min() if len(sj) else 0.0
-    checks_pass = tiles_exactly(mesh.nodes, mesh.quads) \
-        and free_edges_on_boundary(mesh.quads, mesh.boundary) \
-        and boundary_on_free_edges(mesh.quads, mesh.boundary)
-    if 0.0 < worst <= worst_allowed and checks_pass:
-        raise PoorMesh(worst, (cuts, partition, counts, mesh))
     if worst <= worst_allowed:
-        raise PartitionError(f"the block maps give a degenerate element (scaled Jacobian "
-                             f"{worst:.3f})")
+        if worst > 0.0 and tiles_exactly(mesh.nodes, mesh.quads) \
+                and free_edges_on_boundary(mesh.quads, mesh.boundary) \
+                and boundary_on_free_edges(mesh.quads, mesh.boundary):
+            raise PoorMesh(worst, (cuts, partition, counts, mesh))
+        raise PartitionError(_degenerate(worst))
     if not tiles_exactly(mesh.nodes, mesh.quads):
         raise PartitionError("the blocks overlap (their quads fold over each other)")
     if not free_edges_on_boundary(mesh.quads, mesh.boundary):
@@ -291,10 +289,13 @@ class PoorMesh(PartitionError):
     not handed out while gmsh's own quads are better, kept for where they fold."""
 
     def __init__(self, worst: float, result: tuple):
-        super().__init__(f"the block maps give a degenerate element (scaled Jacobian "
-                         f"{worst:.3f})")
+        super().__init__(_degenerate(worst))
         self.worst = worst
         self.result = result
+
+
+def _degenerate(worst: float) -> str:
+    return f"the block maps give a degenerate element (scaled Jacobian {worst:.3f})"
 
 
 def _block_key(partition: Partition, b: int) -> frozenset:

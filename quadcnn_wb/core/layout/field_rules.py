@@ -19,6 +19,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .crossings import cumulative_length
 from .streamlines import Endpoint, Streamline
 
 SNAP = 1.0  # snapping radius around singular points and concave corners, in element sizes
@@ -241,7 +242,7 @@ def _leave_alike(first, second, h) -> bool:
     separatrix only when it comes in beside it, never round to another side of the
     point.  Farther out than the snap's last step, whose kink points anywhere."""
     def heading(points):
-        cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+        cum = cumulative_length(points)
         reach = min(ALIKE_REACH * h, 2.0 * cum[-1] / 3.0)
         d = np.array([np.interp(reach, cum, points[:, 0]),
                       np.interp(reach, cum, points[:, 1])]) - points[0]
@@ -257,8 +258,7 @@ def _blended_tail(points, own, reach):
     Every point moves by its own weight, a smooth function of its distance along the
     line to the end (zero beyond ``reach``): no point is picked by an index, so a turned
     or moved copy of the part gets the same line to round-off."""
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
-    own_cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(own, axis=0).T))])
+    cum, own_cum = cumulative_length(points), cumulative_length(own)
     reach = min(reach, 0.5 * float(cum[-1]), 0.5 * float(own_cum[-1]))
     if reach <= 0:
         return points
