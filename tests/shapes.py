@@ -47,6 +47,12 @@ OWN_SHAPES = {
     "pentagon": ([regular_polygon(5)], 0, 1),
     "hexagon": ([regular_polygon(6)], 0, 2),
     "square with square hole": ([rect(3, 3), rect(1, 1, 1, 1)], 0, 0),
+    # 135° chamfers and a 225°/135° step lie exactly between two quad counts per corner:
+    # the field winds as corner_quads says (before, round-off seeded 83-105 spurious
+    # valence-5 points at them in the input's own pose)
+    "chamfered plate": ([polygon([[0.5, 0], [3.5, 0], [4, 0.5], [4, 2.5], [3.5, 3], [0.5, 3],
+                                  [0, 2.5], [0, 0.5]])], 4, 0),
+    "plate with a 45° step": ([polygon([[0, 0], [3, 0], [3, 1], [2, 1], [1, 2], [0, 2]])], 0, 0),
     "T shape": ([polygon([[0, 0], [1, 0], [1, 2], [2, 2], [2, 3], [-1, 3], [-1, 2],
                           [0, 2]])], 0, 0),
 }

@@ -22,10 +22,14 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # No block partition yet (issue 15's T-mesh partition and quantization): gmsh stands in.
-NO_BLOCKS_YET = {"nist_ctc01_plate", "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
-                 "engine_top", "motor_c_plate", "perforated_plate", "sketch_keyhole_plate",
-                 "sketch_gasket", "sketch_tslot_profile", "sketch_gear"}
-PARTLY_BLOCKS = NO_BLOCKS_YET
+PARTLY_BLOCKS = {"nist_ctc01_plate", "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
+                 "engine_top", "motor_c_plate", "perforated_plate", "sketch_gasket",
+                 "sketch_gear"}
+# All in blocks, but with irregular vertices beside the field's singular points: the
+# T-slot's valence-5 points sit on its 45° arms' 225° corners, whose own vertex then has
+# one quad more than a flat join.
+EXTRA_IRREGULAR = {"sketch_tslot_profile"}
+NO_BLOCKS_YET = PARTLY_BLOCKS | EXTRA_IRREGULAR
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
 
@@ -106,9 +110,12 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # so round-off split its field's zeros differently in every pose until the field was
 # solved in the canonical pose; sketch_bracket: its mirror image got another layout (a
 # zero fitted outside its triangle was clamped from the triangle's first corner, and a
-# separatrix swung onto its neighbour's arm); tailwheel_gusset: a cancelling pair.
+# separatrix swung onto its neighbour's arm); tailwheel_gusset: a cancelling pair;
+# sketch_keyhole_plate and sketch_tslot_profile: 135° and 225° corners, exactly between
+# two quad counts (the field wound at them as round-off had it, seeding singular points).
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
-                                  "sketch_gasket", "sketch_bracket", "tailwheel_gusset"])
+                                  "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
+                                  "sketch_keyhole_plate", "sketch_tslot_profile"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

@@ -8,9 +8,7 @@ Examples: the concave family is "1:11111133" (one loop), four_hole "5:1111|O|O|O
 
 from __future__ import annotations
 
-import math
-
-from ..core.input.corners import interior_angle, is_corner
+from ..core.input.corners import interior_angle, is_corner, nearest_quarters
 
 
 def loop_corners(loop) -> list[int]:
@@ -20,7 +18,7 @@ def loop_corners(loop) -> list[int]:
     for k, curve in enumerate(loop):
         angle = interior_angle(loop[k - 1], curve)
         if is_corner(angle):
-            out.append(int(round(angle / (math.pi / 2))))
+            out.append(nearest_quarters(angle))
     return out
 
 

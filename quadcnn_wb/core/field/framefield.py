@@ -20,6 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from ..input.corners import at_quarter_tie, corner_quads, nearest_quarters
 from .background import BackgroundMesh
 
 
@@ -83,18 +84,28 @@ def cotangent_laplacian(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matr
 
 
 def boundary_values(mesh: BackgroundMesh) -> np.ndarray:
-    """z on boundary nodes: the tangent's fourth power; a corner blends its two edges.
+    """z on boundary nodes: the tangent's fourth power; a corner splits the difference.
 
     At a corner whose angle is a whole number of quarter turns both edges give the same
-    z, so the cross contains both edges exactly; otherwise it splits the difference.
+    z, so the cross contains both edges exactly.  Otherwise the cross turns at the corner
+    by what is left of the tangent's turn after its quarter turns (nearest_quarters), and
+    the corner node holds the cross half-way through that turn: the normalised sum of
+    the two edges' z, except where that sum is zero.  There (a 135° chamfer, a 225° notch)
+    the sum decided nothing, and whichever way round-off then made the field wind seeded
+    a singular point at the corner; now it winds the way its quarter turns say.
     """
     t = mesh.boundary_tangent[:, 0] + 1j * mesh.boundary_tangent[:, 1]
     z = t**4
     position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
-    for node, t_in in zip(mesh.corner_nodes, mesh.corner_tangents_in):
+    for node, t_in, angle in zip(mesh.corner_nodes, mesh.corner_tangents_in,
+                                 mesh.corner_angles):
         k = position[int(node)]
-        blend = complex(*t_in) ** 4 + z[k]
-        if abs(blend) > 1e-9:
+        t_in = complex(*t_in)
+        if at_quarter_tie(float(angle)):
+            turn = np.angle(t[k] / t_in)  # the tangent's turn, signed as the loop runs
+            z[k] = t_in**4 * np.exp(2j * turn) * (-1) ** nearest_quarters(float(angle))
+        else:
+            blend = t_in**4 + z[k]
             z[k] = blend / abs(blend)
     return z
 
@@ -293,7 +304,7 @@ def corner_sources(mesh: BackgroundMesh) -> tuple:
     out = []
     position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
     for node, angle in zip(mesh.corner_nodes, mesh.corner_angles):
-        quarters = int(round(angle / (math.pi / 2)))
+        quarters = corner_quads(angle)
         if quarters < 3:
             continue
         t_out = mesh.boundary_tangent[position[int(node)]]

@@ -2,8 +2,9 @@
 
 The background mesh makes every corner a node that can start separatrices, the topology
 signature counts corners to decide which model fits a domain, and the quality measure
-expects round(angle / 90°) quads at a corner node: all three must mean the same joints
-and the same angles, so the rule lives here once.
+expects a number of quads at a corner node, and the cross field turns at a corner by
+what is left of the tangent's turn after those quads: all of them must mean the same
+joints, the same angles and the same quads per corner, so the rules live here once.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from .curves import cross2
 
 CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not corners
+QUARTER_TIE = 1e-6  # quarter turns: angles this close to an odd multiple of 45° are that tie
 
 
 def interior_angle(incoming, outgoing) -> float:
@@ -27,3 +29,31 @@ def interior_angle(incoming, outgoing) -> float:
 def is_corner(angle: float) -> bool:
     """Whether a joint of this interior angle is a corner (not a smooth join)."""
     return abs(angle - math.pi) > CORNER_MIN_TURN
+
+
+def nearest_quarters(angle: float) -> int:
+    """The interior angle in whole quarter turns, the nearest count: how far the cross
+    field turns at the corner is the tangent's turn less these (0 for a cusp, whose
+    cross carries on as on a smooth stretch).
+
+    A 135° chamfer or a 225° notch lies exactly between two counts, and which one the
+    part's angle rounds to must not hang on round-off (a turned copy's 135° is
+    134.99999999° or 135.00000001°): an angle within QUARTER_TIE of such a tie is the tie,
+    which goes to the even count, as Python's round() does (135° and 225°: 2, a flat join;
+    315°: 4), but for 45°, which gets the one quad a corner cannot do without."""
+    quarters = angle / (math.pi / 2)
+    if at_quarter_tie(angle):
+        nearest_half = math.floor(quarters) + 0.5
+        return 1 if nearest_half == 0.5 else int(round(nearest_half))
+    return int(round(quarters))
+
+
+def at_quarter_tie(angle: float) -> bool:
+    """Whether the angle is (within QUARTER_TIE) an odd multiple of 45°."""
+    quarters = angle / (math.pi / 2)
+    return abs(quarters - math.floor(quarters) - 0.5) <= QUARTER_TIE
+
+
+def corner_quads(angle: float) -> int:
+    """Quads a regular mesh puts at a corner of this interior angle (at least one)."""
+    return max(1, nearest_quarters(angle))

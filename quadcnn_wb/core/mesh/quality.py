@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..input.corners import interior_angle
+from ..input.corners import corner_quads, interior_angle
 from .quadmesh import scaled_jacobians
 
 
 def boundary_quads_expected(domain, nodes, boundary) -> np.ndarray:
-    """Quads a regular boundary node has: round(interior angle / 90°), 2 on smooth stretches."""
+    """Quads a regular boundary node has: input.corners.corner_quads, 2 on smooth stretches."""
     expected = np.where(boundary, 2, 4)
     tree = cKDTree(nodes)
     tol = 1e-9 * domain.size
@@ -23,7 +21,7 @@ def boundary_quads_expected(domain, nodes, boundary) -> np.ndarray:
             dist, node = tree.query(curve.p0)
             if dist <= tol:
                 angle = interior_angle(loop[k - 1], curve)
-                expected[node] = max(1, int(round(angle / (math.pi / 2))))
+                expected[node] = corner_quads(angle)
     return expected
 
 
