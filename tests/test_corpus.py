@@ -25,9 +25,10 @@ OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 PARTLY_BLOCKS = {"nist_ctc01_plate", "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
                  "engine_top", "motor_c_plate", "perforated_plate", "sketch_gasket",
                  "sketch_gear"}
-# All in blocks, but with irregular vertices beside the field's singular points: the
-# T-slot's valence-5 points sit on its 45° arms' 225° corners, whose own vertex then has
-# one quad more than a flat join.
+# All in blocks, but with irregular vertices beside the field's singular points: where
+# each of the T-slot's 45° arms meets its flange, a boundary vertex with three quads
+# (a flat join has two) and an interior one with three, 1.3 sizes apart (a pair the
+# layout makes, not the field).
 EXTRA_IRREGULAR = {"sketch_tslot_profile"}
 NO_BLOCKS_YET = PARTLY_BLOCKS | EXTRA_IRREGULAR
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
