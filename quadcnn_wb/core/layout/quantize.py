@@ -114,14 +114,19 @@ class InfeasibleCounts(PartitionError):
     """No counts make every block's opposite sides equal (HiGHS: the model is infeasible)."""
 
 
-def quantize(partition: Partition, size: float, time_limit: float = 20.0) -> np.ndarray:
+MILP_SECONDS = 60.0  # per solve; past it the counts are refused, not taken unproven
+
+
+def quantize(partition: Partition, size: float,
+             time_limit: float = MILP_SECONDS) -> np.ndarray:
     """Integer segment count per edge of the partition, every block kept (PartitionError
     when no counts make all blocks' opposite sides equal)."""
     counts, freed = _solve(partition, size, time_limit, free_blocks=False)
     return counts
 
 
-def quantize_freeing(partition: Partition, size: float, time_limit: float = 20.0) -> tuple:
+def quantize_freeing(partition: Partition, size: float,
+                     time_limit: float = MILP_SECONDS) -> tuple:
     """(counts, blocks given up): every block kept where that is feasible (the usual
     case, and the faster program), else as few given up as the traces force."""
     try:
