@@ -246,3 +246,18 @@ def test_a_free_face_keeps_a_notch_tip_among_gmsh_nodes(shift):
     if signed_areas(points, quads).sum() < 0:
         quads = quads[:, ::-1]
     assert scaled_jacobians(points, quads).min() > 0.2
+
+
+def test_segment_counts_without_a_proven_optimum_are_refused_not_taken():
+    # A time-limited answer of the integer program would make the counts (and the mesh)
+    # depend on the machine's speed: past its time limit quantize refuses instead.
+    from quadcnn_wb.core.layout.partition_types import PartitionError
+    from quadcnn_wb.core.layout.quantize import InfeasibleCounts, quantize
+
+    result = meshed("four_hole")
+    counts = quantize(result.partition, result.size)
+    assert np.array_equal(counts, result.counts)  # the same program, proven in time
+    with pytest.raises(PartitionError) as refused:
+        quantize(result.partition, result.size, time_limit=1e-9)
+    assert not isinstance(refused.value, InfeasibleCounts)  # not mistaken for "no counts"
+    assert "no proven optimum" in str(refused.value)

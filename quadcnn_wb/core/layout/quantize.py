@@ -215,10 +215,9 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
         result = milp(cost, constraints=[secants, problem.constraint(extra)],
                       integrality=integrality, bounds=bounds,
                       options={"time_limit": time_limit, "mip_rel_gap": 0.0})
-        if result.x is None:
-            error = InfeasibleCounts if result.status == 2 else PartitionError  # 2: infeasible
-            raise error(f"no segment counts make opposite block sides equal "
-                        f"({result.message})")
+        if result.x is None and result.status == 2:  # proven infeasible
+            raise InfeasibleCounts(f"no segment counts make opposite block sides equal "
+                                   f"({result.message})")
         if result.status != 0:  # a time-limited answer would depend on the machine's speed
             raise PartitionError(f"the segment-count program found no proven optimum "
                                  f"within {time_limit:g} s ({result.message})")
