@@ -26,6 +26,17 @@ def regular_polygon(n, r=1.0):
                     for a in np.linspace(0, 2 * math.pi, n + 1)[:-1]])
 
 
+def thin_wall():
+    """An L-shaped wall 1 thick with a 0.08 step up and down along its inner edge and a
+    fillet of radius 0.08 in its concave corner: features of a quarter of the default
+    element size (0.32), like motor_c_plate's 0.6 mm steps and 1 mm fillets."""
+    r = 0.08
+    mid = [9 - r + r * math.cos(math.radians(45)), 7 - r + r * math.sin(math.radians(45))]
+    return polygon([[0, 8], [0, 7], [1, 7], [1, 7.08], [5, 7.08], [5, 7], [9 - r, 7]])[:-1] + [
+        {"arc": [[9 - r, 7], mid, [9, 7 - r]]}] + polygon([[9, 7 - r], [9, 0], [10, 0],
+                                                          [10, 8], [0, 8]])[:-1]
+
+
 def stadium():
     return [{"line": [[0, 0], [2, 0]]}, {"arc": [[2, 0], [3, 1], [2, 2]]},
             {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]
@@ -53,6 +64,9 @@ OWN_SHAPES = {
     "chamfered plate": ([polygon([[0.5, 0], [3.5, 0], [4, 0.5], [4, 2.5], [3.5, 3], [0.5, 3],
                                   [0, 2.5], [0, 0.5]])], 4, 0),
     "plate with a 45° step": ([polygon([[0, 0], [3, 0], [3, 1], [2, 1], [1, 2], [0, 2]])], 0, 0),
+    # Steps and a concave fillet far below the element size are part of the side they sit
+    # on, and the fillet one concave corner: no singular point, no streamline beside them.
+    "thin wall": ([thin_wall()], 0, 0),
     "T shape": ([polygon([[0, 0], [1, 0], [1, 2], [2, 2], [2, 3], [-1, 3], [-1, 2],
                           [0, 2]])], 0, 0),
 }

@@ -23,8 +23,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # No block partition yet (issue 15's T-mesh partition and quantization): gmsh stands in.
 PARTLY_BLOCKS = {"nist_ctc01_plate", "nist_ctc04_plate", "crank_arm_web", "engine_bottom",
-                 "engine_top", "motor_c_plate", "perforated_plate", "sketch_gasket",
-                 "sketch_gear"}
+                 "perforated_plate", "sketch_gasket", "sketch_gear"}
 # All in blocks, but with irregular vertices beside the field's singular points: where
 # each of the T-slot's 45° arms meets its flange, a boundary vertex with three quads
 # (a flat join has two) and an interior one with three, 1.3 sizes apart (a pair the
@@ -113,10 +112,15 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # zero fitted outside its triangle was clamped from the triangle's first corner, and a
 # separatrix swung onto its neighbour's arm); tailwheel_gusset: a cancelling pair;
 # sketch_keyhole_plate and sketch_tslot_profile: 135° and 225° corners, exactly between
-# two quad counts (the field wound at them as round-off had it, seeding singular points).
+# two quad counts (the field wound at them as round-off had it, seeding singular points);
+# motor_c_plate: steps and fillets below the element size (input.features).  Not yet
+# engine_top: its mirrored copy gets 35 blocks for 36 (the same features; a small
+# fillet's corner goes to the background node nearest the arc's middle, and where two
+# nodes lie equally near, the one first in the loop's direction, which a mirror reverses).
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
-                                  "sketch_keyhole_plate", "sketch_tslot_profile"])
+                                  "sketch_keyhole_plate", "sketch_tslot_profile",
+                                  "motor_c_plate"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

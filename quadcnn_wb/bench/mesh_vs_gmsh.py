@@ -12,16 +12,19 @@ from __future__ import annotations
 import argparse
 import statistics
 
+from ..core.input.pose import DEFAULT_SIZE_DIVISOR
 from ..core.mesh.gmsh_quads import gmsh_quasi_structured
 from ..core.mesh.quadmesh import scaled_jacobians
 from ..core.mesh.quality import boundary_quads_expected, irregular_vertices
-from ..core.pipeline import DEFAULT_SIZE_DIVISOR, mesh_domain
+from ..core.pipeline import mesh_domain
 from .common import bundled_examples
 
 
-def score(domain, nodes, quads, boundary):
+def score(domain, nodes, quads, boundary, size):
+    """(quads, worst and mean scaled Jacobian, irregular vertices) of a mesh made at
+    element size ``size``, by our own quality rules."""
     sj = scaled_jacobians(nodes, quads)
-    expected = boundary_quads_expected(domain, nodes, boundary)
+    expected = boundary_quads_expected(domain, nodes, boundary, size)
     irregular = len(irregular_vertices(quads, len(nodes), expected))
     return len(quads), float(sj.min()), float(sj.mean()), irregular
 
@@ -50,7 +53,7 @@ def main(argv=None) -> int:
                 domain, size * args.gmsh_size_factor)
             peer_t.append(seconds)
         q = result.quality
-        peer = score(domain, nodes, quads, boundary)
+        peer = score(domain, nodes, quads, boundary, size)
         ours_s, peer_s = statistics.median(ours_t), statistics.median(peer_t)
         print(f"{name:<11} {size:>7.4f} | {q['quads']:>11} {q['min_scaled_jacobian']:>6.3f} "
               f"{q['mean_scaled_jacobian']:>6.3f} {q['irregular_vertices']:>4} "

@@ -16,7 +16,7 @@ import numpy as np
 from .field.pairs import without_cancelling_pairs
 from .field.reference import Reference, background_and_field
 from .input.domain import Domain
-from .input.pose import diameter
+from .input.pose import default_size
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import build_partition
@@ -27,7 +27,6 @@ from .mesh.gmsh_quads import gmsh_quad_mesh
 from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
 from .mesh.quality import mesh_quality, structured_share
 
-DEFAULT_SIZE_DIVISOR = 40  # default element size: the part's diameter / this
 MIN_VALID_JACOBIAN = 0.05  # a block-structured mesh worse than this is not handed out
 
 
@@ -74,12 +73,6 @@ class MeshResult:
             "quality": dict(self.quality),
             "timings": dict(self.timings),
         }
-
-
-def default_size(domain: Domain) -> float:
-    """The part's diameter / 40: the bounding-box diagonal for rectangles, and unlike it
-    the same for a turned copy."""
-    return diameter(domain) / DEFAULT_SIZE_DIVISOR
 
 
 def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
@@ -138,7 +131,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
     timings = {}
     # The cnn path needs the node count its network was trained for; tracing does not.
     background, field = background_and_field(domain, nodes, timings,
-                                             strict=method == "cnn")
+                                             strict=method == "cnn", feature_size=size)
     # Pairs of singular points that cancel are no structure (field.pairs): the layout
     # (and the result's singular points) is made from the others.
     field = without_cancelling_pairs(field, background.element_size)
@@ -191,7 +184,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
             timings["quad_mesh"] += time.perf_counter() - clock
     problem = problem or free_face_problem(partition)
     clock = time.perf_counter()
-    quality = mesh_quality(domain, mesh)
+    quality = mesh_quality(domain, mesh, size)
     timings["quality"] = time.perf_counter() - clock
     timings["total"] = sum(timings.values())
     reference = Reference(domain, background, field, tuple(lines), None, dict(timings))
@@ -226,7 +219,8 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     timings["partition"] += time.perf_counter() - clock
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
-        partition = build_partition(domain, lines, background.element_size, cuts, dissolve)
+        partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
+                                    background.flat_joints)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")

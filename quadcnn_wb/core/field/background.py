@@ -10,6 +10,7 @@ parameter and tangent, because the frame field is aligned with that tangent.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -23,7 +24,8 @@ from ..gmsh_session import gmsh_session
 from ..input.corners import interior_angle, is_corner
 from ..input.curves import Arc
 from ..input.domain import Domain
-from ..input.pose import KEY_DIGITS, canonical_pose
+from ..input.features import boundary_features, loop_offsets
+from ..input.pose import KEY_DIGITS, canonical_pose, default_size
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
 NODE_SLACK = 10  # ... or target ± this many, whichever is wider: below a few hundred nodes
@@ -50,6 +52,9 @@ class BackgroundMesh:
     corner_angles: np.ndarray  # (C,) interior angle in radians, in (0, 2*pi]
     corner_tangents_in: np.ndarray  # (C, 2) unit tangent of the curve arriving at the corner
     element_size: float
+    # (loop, segment) of the loop vertices that are no corner at the mesh's scale: part of
+    # a feature below the element size (input.features), read as part of a side.
+    flat_joints: frozenset = frozenset()
 
     @property
     def n_nodes(self) -> int:
@@ -142,8 +147,11 @@ LOOSE_TOLERANCE = 0.5  # what the mesher accepts when the exact count cannot be 
 
 
 def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
-                    strict: bool = True) -> BackgroundMesh:
+                    strict: bool = True, feature_size: float | None = None) -> BackgroundMesh:
     """Triangulate the domain with ``nodes`` nodes, within NODE_TOLERANCE or NODE_SLACK.
+
+    ``feature_size``: the element size of the quad mesh to come (default: the part's
+    default size); boundary features below it are read at that scale (input.features).
 
     strict=False (the meshing pipeline) takes the closest count within LOOSE_TOLERANCE
     when a part with features far below the element size jumps over the target: the
@@ -185,7 +193,9 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
             f"could not reach {nodes} nodes within {NODE_TOLERANCE:.0%} (best "
             f"{len(coords)}); the shape may have features far below the element size")
     coords = pose.from_unit(coords)
-    return _assemble(domain, coords, triangles, curve_nodes, h * pose.scale, pose.scale)
+    mesh = _assemble(domain, coords, triangles, curve_nodes, h * pose.scale, pose.scale)
+    size = default_size(domain) if feature_size is None else feature_size
+    return with_features(mesh, domain, boundary_features(domain, size))
 
 
 def _read_mesh(curve_tags: dict):
@@ -258,6 +268,60 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
         corner_angles=np.array(corner_angles, dtype=float),
         corner_tangents_in=np.array(corner_in, dtype=float).reshape(-1, 2),
         element_size=float(h))
+
+
+def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundMesh:
+    """The mesh with its boundary read through ``features`` (input.features): a feature's
+    joints are no corners, a concave one is one corner at its pivot (a boundary node),
+    and over the stretch the boundary's tangent is the one arriving at it up to the
+    pivot and the one leaving it from there, so the cross field turns as at one corner."""
+    if not features:
+        return mesh
+    tangents = mesh.boundary_tangent.copy()
+    at = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    corners = {}  # boundary position -> (node, angle, tangent in)
+    where = {}  # (loop, segment) of each loop vertex's corner -> boundary position
+    for node, angle, t_in in zip(mesh.corner_nodes, mesh.corner_angles,
+                                 mesh.corner_tangents_in):
+        k = at[int(node)]
+        corners[k] = (int(node), float(angle), t_in)
+        where[(int(mesh.boundary_loop[k]), int(mesh.boundary_segment[k]))] = k
+    flat = set()
+    for feature in features:
+        loop = domain.loops[feature.loop]
+        offsets = loop_offsets(loop)
+        total = float(offsets[-1])
+        on_loop = np.nonzero(mesh.boundary_loop == feature.loop)[0]
+        segs = mesh.boundary_segment[on_loop]
+        s = offsets[segs] + mesh.boundary_param[on_loop] * np.array(
+            [loop[si].length for si in segs])
+        for si in feature.joints:
+            flat.add((feature.loop, si))
+            corners.pop(where.get((feature.loop, si)), None)
+        pivot_s = feature.pivot
+        if feature.angle is not None:
+            mine = on_loop[segs == feature.pivot_segment]
+            if len(mine):
+                params = mesh.boundary_param[mine]
+                k = int(mine[np.argmin(np.abs(params - feature.pivot_param))])
+                pivot_s = float(offsets[feature.pivot_segment] + mesh.boundary_param[k]
+                                * loop[feature.pivot_segment].length)
+                corners[k] = (int(mesh.boundary_nodes[k]), float(feature.angle),
+                              feature.tangent_in)
+        into = (s - feature.start) % total  # arc length into the stretch
+        pivot = (pivot_s - feature.start) % total
+        inside = into < feature.end - feature.start
+        before = inside & ((into < pivot) | (feature.angle is None))
+        tangents[on_loop[before]] = feature.tangent_in
+        tangents[on_loop[inside & ~before]] = feature.tangent_out
+    order = sorted(corners)
+    return dataclasses.replace(
+        mesh, boundary_tangent=tangents,
+        corner_nodes=np.array([corners[k][0] for k in order], dtype=np.int64),
+        corner_angles=np.array([corners[k][1] for k in order], dtype=float),
+        corner_tangents_in=np.array([corners[k][2] for k in order],
+                                    dtype=float).reshape(-1, 2),
+        flat_joints=frozenset(flat))
 
 
 def _counter_clockwise(coords, triangles):

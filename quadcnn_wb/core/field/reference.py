@@ -44,11 +44,13 @@ class Reference:
 
 
 def background_and_field(domain: Domain, nodes: int, timings: dict,
-                         mesh: BackgroundMesh | None = None, strict: bool = True):
-    """The stages every path shares: background mesh (unless given) and cross field."""
+                         mesh: BackgroundMesh | None = None, strict: bool = True,
+                         feature_size: float | None = None):
+    """The stages every path shares: background mesh (unless given) and cross field.
+    ``feature_size``: the quad mesh's element size (background_mesh)."""
     clock = time.perf_counter()
     if mesh is None:
-        mesh = background_mesh(domain, nodes=nodes, strict=strict)
+        mesh = background_mesh(domain, nodes=nodes, strict=strict, feature_size=feature_size)
         timings["background"] = time.perf_counter() - clock
         clock = time.perf_counter()
     field = compute_frame_field(mesh, canonical_pose(domain))

@@ -86,6 +86,15 @@ def diameter(domain) -> float:
     return best
 
 
+DEFAULT_SIZE_DIVISOR = 40  # default element size: the part's diameter / this
+
+
+def default_size(domain) -> float:
+    """The part's diameter / 40: the bounding-box diagonal for rectangles, and unlike it
+    the same for a turned copy."""
+    return diameter(domain) / DEFAULT_SIZE_DIVISOR
+
+
 def _key(value: float, scale: float) -> float:
     return round(value / scale, KEY_DIGITS)
 

@@ -77,14 +77,14 @@ def separatrix_sources(mesh, field, walker, h) -> list:
     for cs in field.corner_sources:
         k = position[cs.node]
         corner = Endpoint("corner", cs.node, int(mesh.boundary_loop[k]),
-                          int(mesh.boundary_segment[k]), 0.0)
+                          int(mesh.boundary_segment[k]), float(mesh.boundary_param[k]))
         for branch, d in enumerate(cs.directions):
             probe = cs.xy + 1e-6 * h * d
             tris = np.array(incident[cs.node])
             b = walker.barycentric(tris, np.repeat(probe[None], len(tris), axis=0))
             t0 = int(tris[np.argmax(b.min(axis=1))])
             out.append((cs.xy, d, t0, Endpoint(corner.kind, corner.index, corner.loop,
-                                               corner.segment, 0.0, branch)))
+                                               corner.segment, corner.param, branch)))
     return out
 
 
@@ -97,7 +97,7 @@ def snap_targets(mesh, field) -> tuple[np.ndarray, list]:
     for c in field.corner_sources:
         k = int(np.nonzero(mesh.boundary_nodes == c.node)[0][0])
         kind.append(Endpoint("corner", c.node, int(mesh.boundary_loop[k]),
-                             int(mesh.boundary_segment[k]), 0.0))
+                             int(mesh.boundary_segment[k]), float(mesh.boundary_param[k])))
     return np.array(xy).reshape(-1, 2), kind
 
 

@@ -64,10 +64,12 @@ def _boundary_key(domain, loop: int, seg: int, t: float):
 
 
 def build_partition(domain, streamlines, element_size: float, cuts=(),
-                    dissolve=frozenset()) -> Partition:
+                    dissolve=frozenset(), flat_joints=frozenset()) -> Partition:
     """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py),
     less the streamline edges whose origin is in ``dissolve`` (faces merged where a free
-    face could not be filled)."""
+    face could not be filled).  ``flat_joints``: (loop, segment) of the loop vertices in a
+    feature below the element size (BackgroundMesh.flat_joints): no vertex there, the
+    boundary edge runs through (mesh nodes along it at equal arc length)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -79,7 +81,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     boundary_splits: dict = {li: set() for li in range(len(domain.loops))}
     for li, loop in enumerate(domain.loops):
         for si, curve in enumerate(loop):
-            if curve.kind != "circle":
+            if curve.kind != "circle" and (li, si) not in flat_joints:
                 boundary_splits[li].add((si, 0.0))
     for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
         # A singular point on the boundary itself (its separatrix there has no length) is

@@ -1,0 +1,155 @@
+"""Boundary features below the element size, read as what they are at the mesh's scale.
+
+A 0.6 mm step on a part meshed at 3.4 mm, a 1 mm fillet in a concave corner, a bump of a
+tenth of an element: the mesh cannot follow their shape, and read literally they break
+the layout.  Each corner of a step seeds its own streamlines, which then run a fraction
+of an element from the boundary for the length of the part; a small fillet in a concave
+corner is smooth, so no streamline leaves it and the face around it keeps a reflex
+corner; a bump's tilted edge bends the cross field into a singular point.
+
+So the boundary is read at the element's scale.  Its turns (each corner, and the whole
+turn of each curve shorter than FEATURE sizes) are grouped into stretches no longer than
+FEATURE sizes; a stretch holding more than one turn, or a short curve's, is one feature
+with the sum of its turns:
+- a feature that turns by a whole half turn less (after rounding) than a straight line,
+  i.e. whose interior angle rounds to two quarter turns (a step, a bump), is flat: part
+  of the side it sits on, with no corner and no corner streamlines;
+- a feature that turns the other way by a quarter turn or more (a concave fillet or a
+  concave chamfer under FEATURE sizes) is one concave corner, at its largest turn (a
+  short curve's middle), with that corner's streamlines;
+- a convex feature stays as its curves and corners are (a small convex fillet or chamfer
+  already gets its singular point or its corner from the field).
+A lone corner is never changed, nor a flat stretch whose corners are each flat already
+(a curve stored as a polyline), so a part with no such features below the element size
+is read exactly as before.  The field (background.py), its corner streamlines, the
+partition's corner test and the quality measure's expected quads all read the boundary
+through these features, so they agree on where the corners are.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .corners import interior_angle, is_corner, nearest_quarters
+
+FEATURE = 0.5  # element sizes: turns closer together than this are one feature
+ROUND = 1.0  # element sizes: a fillet of a smaller radius is read as a corner ...
+ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle stays a curve)
+MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
+JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A stretch of one loop read as one joint: a corner (angle) or flat (angle None)."""
+
+    loop: int
+    joints: tuple  # segments whose starting joint lies in the stretch, but the pivot: no
+    #                corner, and no place a mesh node must sit (the side runs through)
+    start: float  # arc length along the loop where the stretch starts
+    end: float  # ... and ends (may exceed the loop's length: the stretch wraps)
+    pivot: float  # arc length of the one corner it stands for (flat: its start)
+    pivot_segment: int  # the curve holding the pivot
+    pivot_param: float  # its parameter there (0.0: the joint at the curve's start)
+    angle: float | None  # interior angle of the whole stretch; None: flat
+    tangent_in: np.ndarray  # the tangent arriving at the stretch
+    tangent_out: np.ndarray  # the tangent leaving it
+
+
+def loop_offsets(loop) -> np.ndarray:
+    """Arc length at the start of each curve of a loop."""
+    return np.concatenate([[0.0], np.cumsum([c.length for c in loop])])
+
+
+def _turns(loop) -> list:
+    """(arc length, signed turn, segment, kind, start, end) of each corner and each short
+    curve's whole turn, in loop order; the turn is positive to the left."""
+    offsets = loop_offsets(loop)
+    out = []
+    for si, curve in enumerate(loop):
+        angle = interior_angle(loop[si - 1], curve)
+        if is_corner(angle):
+            out.append((offsets[si], math.pi - angle, si, "joint", offsets[si], offsets[si]))
+        sweep = getattr(curve, "sweep", 0.0)
+        if sweep:
+            out.append((offsets[si] + 0.5 * curve.length, sweep, si, "curve",
+                        offsets[si], offsets[si + 1]))
+    return out
+
+
+def boundary_features(domain, size: float) -> list:
+    """The features of every loop at element size ``size`` (see the module docstring).
+
+    Turns chain into one feature while each is less than FEATURE sizes from the next, a
+    rule that reads a loop the same both ways round (a mirrored copy runs the other way);
+    a chain longer than MAX_SPAN sizes (a curve stored as a polyline) is read as it is."""
+    out = []
+    reach = FEATURE * size
+    for li, loop in enumerate(domain.loops):
+        if len(loop) < 2:
+            continue  # a lone circle: no corner to read
+        total = float(loop_offsets(loop)[-1])
+        turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
+                 or (loop[t[2]].radius < ROUND * size and abs(t[1]) <= ROUND_SWEEP)]
+        if not turns:
+            continue
+        gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
+        if len(turns) > 1 and max(gaps) < reach:
+            continue  # the whole loop is one chain: read as it is
+        first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
+        chains, chain = [], []
+        for k in range(first, first + len(turns)):
+            chain.append(turns[k % len(turns)])
+            if gaps[k % len(turns)] >= reach:
+                chains.append(chain)
+                chain = []
+        for chain in chains:
+            feature = _feature(li, loop, chain, total, size)
+            if feature is not None:
+                out.append(feature)
+    return out
+
+
+def _feature(li, loop, group, total, size) -> Feature | None:
+    if len(group) == 1 and group[0][3] == "joint":
+        return None  # a lone corner: as it is
+    span = (group[-1][5] - group[0][4]) % total
+    if span > MAX_SPAN * size:
+        return None  # a long chain of turns: a curve stored as a polyline
+    turn = sum(t[1] for t in group)
+    angle = math.pi - turn
+    quarters = nearest_quarters(angle) if is_corner(angle) else 2
+    if quarters < 2:
+        return None  # convex: its curves and corners as they are
+    if quarters == 2 and all(t[3] == "curve" or nearest_quarters(math.pi - t[1]) == 2
+                             for t in group):
+        return None  # flat, and so is each of its corners: nothing to change
+    first, last = group[0], group[-1]
+    start = first[4]
+    end = last[5] if last[5] >= start else last[5] + total
+    offsets = loop_offsets(loop)[:-1]
+    inside = [si for si, at in enumerate(offsets)
+              if (at - start) % total <= end - start]
+    t_in = loop[first[2] - 1].tangent(1.0) if first[3] == "joint" \
+        else loop[first[2]].tangent(0.0)
+    t_out = loop[last[2]].tangent(0.0) if last[3] == "joint" else loop[last[2]].tangent(1.0)
+    if quarters == 2:
+        return Feature(li, tuple(inside), start, end, start, first[2],
+                       0.0 if first[3] == "joint" else 0.5, None, np.asarray(t_in, float),
+                       np.asarray(t_out, float))
+    # The corner sits in the stretch's middle, the same place whichever way the loop
+    # runs; on a joint there if the middle is one.
+    middle = (start + 0.5 * (end - start)) % total
+    offsets = loop_offsets(loop)
+    seg = int(np.clip(np.searchsorted(offsets, middle, side="right") - 1, 0, len(loop) - 1))
+    param = (middle - offsets[seg]) / loop[seg].length
+    if param >= 1.0 - JOINT_TOL:
+        seg, param = (seg + 1) % len(loop), 0.0
+    elif param <= JOINT_TOL:
+        param = 0.0
+    joints = tuple(si for si in inside if not (param == 0.0 and si == seg))
+    return Feature(li, joints, start, end, middle, seg, float(param), angle,
+                   np.asarray(t_in, float), np.asarray(t_out, float))

@@ -1,0 +1,65 @@
+"""Boundary features below the element size (input.features): steps and bumps are part of
+the side they sit on, a small concave fillet is one concave corner, the rest is as it is."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from shapes import OWN_SHAPES, named_domain, rect, rotation, transform_domain
+
+from quadcnn_wb.core.field.background import background_mesh
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.features import boundary_features
+from quadcnn_wb.core.input.pose import default_size
+
+
+def summary(features):
+    """(joints, angle in degrees or -1 for flat) of each feature, sorted."""
+    return sorted((len(f.joints), -1.0 if f.angle is None else round(math.degrees(f.angle), 6))
+                  for f in features)
+
+
+def test_steps_are_flat_and_a_small_concave_fillet_is_one_corner():
+    domain = named_domain("thin wall")
+    features = boundary_features(domain, default_size(domain))
+    # Two steps (each two corners, flat), one fillet (its two smooth joints, 270°).
+    assert summary(features) == [(2, -1.0), (2, -1.0), (2, 270.0)]
+    fillet = next(f for f in features if f.angle is not None)
+    assert fillet.pivot_param == pytest.approx(0.5)  # the arc's middle
+
+
+def test_at_a_size_that_resolves_them_the_boundary_is_read_as_it_is():
+    domain = named_domain("thin wall")
+    assert boundary_features(domain, default_size(domain) / 10) == []
+
+
+@pytest.mark.parametrize("loops", [[rect(3, 2)], OWN_SHAPES["chamfered plate"][0],
+                                   OWN_SHAPES["T shape"][0]],
+                         ids=["rectangle", "chamfered plate", "T shape"])
+def test_corners_apart_are_never_a_feature(loops):
+    domain = domain_from_json({"loops": loops})
+    assert boundary_features(domain, default_size(domain)) == []
+
+
+@pytest.mark.parametrize("matrix", [rotation(37), rotation(211, 1e3, mirror=True),
+                                    rotation(131, 1e-3, mirror=True)],
+                         ids=["turned", "turned+scaled+mirrored", "turned+shrunk+mirrored"])
+def test_features_are_the_same_in_every_pose(matrix):
+    loops = OWN_SHAPES["thin wall"][0]
+    moved = domain_from_json(transform_domain({"loops": loops}, matrix, shift=(1e4, -7.0)))
+    assert summary(boundary_features(moved, default_size(moved))) == \
+        [(2, -1.0), (2, -1.0), (2, 270.0)]
+
+
+def test_the_background_has_the_fillet_corner_and_no_step_corners():
+    domain = named_domain("thin wall")
+    mesh = background_mesh(domain, nodes=1000)
+    angles = sorted(round(math.degrees(a), 6) for a in mesh.corner_angles)
+    # The L's six 90° corners (four outside, ...) and the fillet's 270°; no step corners.
+    assert angles.count(270.0) == 1
+    assert all(a == 90.0 for a in angles if a != 270.0)
+    assert len(mesh.flat_joints) == 6  # both steps' corners, the fillet's two ends
+    fine = background_mesh(domain, nodes=1000, feature_size=default_size(domain) / 10)
+    assert fine.flat_joints == frozenset()
+    assert len(fine.corner_angles) == len(domain.loops[0]) - 2  # the fillet's ends are smooth
