@@ -116,9 +116,8 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # sketch_keyhole_plate and sketch_tslot_profile: 135° and 225° corners, exactly between
 # two quad counts (the field wound at them as round-off had it, seeding singular points);
 # motor_c_plate: steps and fillets below the element size (input.features).  Not yet
-# engine_top: its mirrored copy gets 35 blocks for 36 (the same features; a small
-# fillet's corner goes to the background node nearest the arc's middle, and where two
-# nodes lie equally near, the one first in the loop's direction, which a mirror reverses).
+# engine_top: its mirrored copy (211°) gets 35 blocks for 36, with the same features and
+# the same 8 singular points; the separatrices that circle its four bosses' bores differ.
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",

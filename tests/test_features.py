@@ -63,3 +63,19 @@ def test_the_background_has_the_fillet_corner_and_no_step_corners():
     fine = background_mesh(domain, nodes=1000, feature_size=default_size(domain) / 10)
     assert fine.flat_joints == frozenset()
     assert len(fine.corner_angles) == len(domain.loops[0]) - 2  # the fillet's ends are smooth
+
+
+@pytest.mark.parametrize("nodes", [1000, 3000, 6000])
+@pytest.mark.parametrize("mirror", [False, True], ids=["as drawn", "mirrored"])
+def test_the_fillet_corner_is_a_background_node_at_the_arc_middle(mirror, nodes):
+    import numpy as np
+
+    loops = OWN_SHAPES["thin wall"][0]
+    domain = domain_from_json(transform_domain({"loops": loops}, rotation(23, mirror=mirror),
+                                               shift=(5.0, 1.0)))
+    mesh = background_mesh(domain, nodes=nodes)
+    fillet = next(f for f in boundary_features(domain, default_size(domain))
+                  if f.angle is not None)
+    middle = domain.loops[fillet.loop][fillet.pivot_segment].point(fillet.pivot_param)
+    corner = mesh.corner_nodes[np.argmax(mesh.corner_angles)]
+    assert np.hypot(*(mesh.nodes[corner] - middle)) <= 1e-9 * domain.size

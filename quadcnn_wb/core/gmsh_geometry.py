@@ -25,14 +25,16 @@ def unit(value):
     return np.round(value, UNIT_DIGITS) + 0.0  # + 0.0: no negative zeros either
 
 
-def _unit_loops(domain: Domain, pose: Pose):
+def _unit_loops(domain: Domain, pose: Pose, splits=None):
     """The loops in unit coordinates, in an order that depends on the shape alone.
 
     Each loop is a list of (loop index, segment index, start, middle or None, end) with the
     domain on the left in the pose (a mirrored pose reverses the loops), starting at its
     lowest-then-leftmost vertex; holes sorted by that vertex.  Full circles are
-    (loop index, centre, radius).
+    (loop index, centre, radius).  ``splits``: {(loop, segment): parameter} of curves cut
+    in two there (each half is one entry, with the same indices).
     """
+    splits = splits or {}
     loops = []
     for li, loop in enumerate(domain.loops):
         if len(loop) == 1 and isinstance(loop[0], Arc) and loop[0].is_full:
@@ -41,8 +43,13 @@ def _unit_loops(domain: Domain, pose: Pose):
             continue
         pieces = []
         for si, c in enumerate(loop):
-            mid = unit(pose.to_unit(c.midpoint())) if isinstance(c, Arc) else None
-            pieces.append((li, si, unit(pose.to_unit(c.p0)), mid, unit(pose.to_unit(c.p1))))
+            cut = splits.get((li, si))
+            stretches = ((0.0, 1.0),) if cut is None else ((0.0, cut), (cut, 1.0))
+            for t0, t1 in stretches:
+                mid = unit(pose.to_unit(c.point(0.5 * (t0 + t1)))) if isinstance(c, Arc) \
+                    else None
+                pieces.append((li, si, unit(pose.to_unit(c.point(t0))), mid,
+                               unit(pose.to_unit(c.point(t1)))))
         if pose.mirrored:
             pieces = [(li, si, end, mid, start) for li, si, start, mid, end in pieces[::-1]]
         first = min(range(len(pieces)), key=lambda k: (pieces[k][2][1], pieces[k][2][0]))
@@ -55,15 +62,17 @@ def _unit_loops(domain: Domain, pose: Pose):
     return [loops[0]] + sorted(loops[1:], key=start_key)
 
 
-def build_geometry(domain: Domain, pose: Pose) -> dict:
+def build_geometry(domain: Domain, pose: Pose, splits=None) -> dict:
     """OCC curves for every domain curve, in unit coordinates; returns tag -> (loop, seg).
 
-    Into the current gmsh model (inside a gmsh_session); the caller meshes it."""
+    Into the current gmsh model (inside a gmsh_session); the caller meshes it.
+    ``splits``: {(loop, segment): parameter} where a curve gets a vertex (and so a mesh
+    node) of its own; both halves map to the curve's (loop, seg)."""
     occ = gmsh.model.occ
     curve_tags = {}
     loop_tags = []
     helpers = []
-    for loop in _unit_loops(domain, pose):
+    for loop in _unit_loops(domain, pose, splits):
         if isinstance(loop, tuple):
             li, q, radius = loop
             tag = occ.addCircle(q[0], q[1], 0.0, radius)

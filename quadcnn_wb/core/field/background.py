@@ -160,6 +160,12 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     if nodes < 8:
         raise ValueError(f"--nodes must be at least 8, got {nodes}")
     pose = canonical_pose(domain)
+    size = default_size(domain) if feature_size is None else feature_size
+    features = boundary_features(domain, size)
+    # A concave feature's corner inside a curve gets a vertex there: the one node that
+    # stands for it, the same in a mirrored copy (the nearest of two could not be).
+    splits = {(f.loop, f.pivot_segment): f.pivot_param for f in features
+              if f.angle is not None and f.pivot_param > 0.0}
     # Rounded well above round-off (a moved or turned copy must ask gmsh for the same size).
     unit_area = round(domain.area / pose.scale**2, KEY_DIGITS)
     unit_perimeter = round(domain.perimeter / pose.scale, KEY_DIGITS)
@@ -167,7 +173,7 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
     with gmsh_session(threads) as session:
-        curve_tags = build_geometry(domain, pose)
+        curve_tags = build_geometry(domain, pose, splits)
         for option, value in (("Mesh.Algorithm", GMSH_ALGORITHM),
                               ("Mesh.MeshSizeFromPoints", 0),
                               ("Mesh.MeshSizeFromCurvature", 0),
@@ -194,8 +200,7 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
             f"{len(coords)}); the shape may have features far below the element size")
     coords = pose.from_unit(coords)
     mesh = _assemble(domain, coords, triangles, curve_nodes, h * pose.scale, pose.scale)
-    size = default_size(domain) if feature_size is None else feature_size
-    return with_features(mesh, domain, boundary_features(domain, size))
+    return with_features(mesh, domain, features)
 
 
 def _read_mesh(curve_tags: dict):
@@ -218,7 +223,10 @@ def _read_mesh(curve_tags: dict):
     curve_nodes = {}
     for tag, key in curve_tags.items():
         ntags, _, _ = gmsh.model.mesh.getNodes(1, tag, includeBoundary=True)
-        curve_nodes[key] = index[np.asarray(ntags, dtype=np.int64)]
+        ids = index[np.asarray(ntags, dtype=np.int64)]
+        # A split curve's halves: one list (sorted along the curve later, shared end once).
+        curve_nodes[key] = np.concatenate([curve_nodes[key], ids]) if key in curve_nodes \
+            else ids
     return coords, triangles, curve_nodes
 
 
