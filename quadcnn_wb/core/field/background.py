@@ -24,7 +24,7 @@ from ..gmsh_session import gmsh_session
 from ..input.corners import interior_angle, is_corner
 from ..input.curves import Arc
 from ..input.domain import Domain
-from ..input.features import boundary_features, loop_offsets
+from ..input.features import JOINT_TOL, boundary_features, loop_offsets
 from ..input.pose import KEY_DIGITS, canonical_pose, default_size
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
@@ -319,9 +319,16 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
         into = (s - feature.start) % total  # arc length into the stretch
         pivot = (pivot_s - feature.start) % total
         inside = into < feature.end - feature.start
-        before = inside & ((into < pivot) | (feature.angle is None))
+        tol = JOINT_TOL * total
+        before = inside & (into < pivot - tol)
+        after = inside & (into > pivot + tol)
         tangents[on_loop[before]] = feature.tangent_in
-        tangents[on_loop[inside & ~before]] = feature.tangent_out
+        tangents[on_loop[after]] = feature.tangent_out
+        if feature.angle is None:  # a flat stretch's middle node: the mean tangent
+            mean = feature.tangent_in + feature.tangent_out
+            tangents[on_loop[inside & ~before & ~after]] = mean / np.hypot(*mean)
+        else:  # the corner node: the tangent leaving it, as at any corner
+            tangents[on_loop[inside & ~before & ~after]] = feature.tangent_out
     order = sorted(corners)
     return dataclasses.replace(
         mesh, boundary_tangent=tangents,

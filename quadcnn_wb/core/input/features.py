@@ -8,21 +8,26 @@ corner is smooth, so no streamline leaves it and the face around it keeps a refl
 corner; a bump's tilted edge bends the cross field into a singular point.
 
 So the boundary is read at the element's scale.  Its turns (each corner, and the whole
-turn of each curve shorter than FEATURE sizes) are grouped into stretches no longer than
-FEATURE sizes; a stretch holding more than one turn, or a short curve's, is one feature
-with the sum of its turns:
-- a feature that turns by a whole half turn less (after rounding) than a straight line,
-  i.e. whose interior angle rounds to two quarter turns (a step, a bump), is flat: part
-  of the side it sits on, with no corner and no corner streamlines;
-- a feature that turns the other way by a quarter turn or more (a concave fillet or a
-  concave chamfer under FEATURE sizes) is one concave corner, at its largest turn (a
-  short curve's middle), with that corner's streamlines;
+turn of each curve shorter than FEATURE sizes or of a concave fillet of radius under ROUND
+sizes turning at most ROUND_SWEEP) chain while each lies less than FEATURE sizes from the next;
+a chain holding more than one turn, or a curve's, is one feature with the sum of its
+turns:
+- a feature whose interior angle rounds to two quarter turns (a step, a bump) is flat:
+  part of the side it sits on, with no corner, no corner streamlines and no vertex of the
+  partition (the side's mesh nodes run over it);
+- a feature that turns the other way by a quarter turn or more (a concave fillet of a
+  radius under ROUND sizes, a concave chamfer under FEATURE sizes) is one concave corner,
+  in the middle of the stretch, with that corner's streamlines.  Read as a curve, such a
+  fillet needs a valence-5 singular point beside it, which the background cannot place
+  well when the radius is a few elements or less (motor_c_plate's 1 mm fillets got
+  none, the gear's root fillets a cluster); as a corner it needs none, and the quads at
+  its middle meet at 45° to the curve plus what the curve turns under one element;
 - a convex feature stays as its curves and corners are (a small convex fillet or chamfer
   already gets its singular point or its corner from the field).
-A lone corner is never changed, nor a flat stretch whose corners are each flat already
-(a curve stored as a polyline), so a part with no such features below the element size
-is read exactly as before.  The field (background.py), its corner streamlines, the
-partition's corner test and the quality measure's expected quads all read the boundary
+A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
+a chain longer than MAX_SPAN sizes (a curve stored as a polyline), so a part with no such
+features is read exactly as before.  The field (background.py), its corner streamlines,
+the partition's vertices and the quality measure's expected quads all read the boundary
 through these features, so they agree on where the corners are.
 """
 
@@ -36,7 +41,7 @@ import numpy as np
 from .corners import interior_angle, is_corner, nearest_quarters
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
-ROUND = 1.0  # element sizes: a fillet of a smaller radius is read as a corner ...
+ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
 ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle stays a curve)
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
@@ -47,11 +52,11 @@ class Feature:
     """A stretch of one loop read as one joint: a corner (angle) or flat (angle None)."""
 
     loop: int
-    joints: tuple  # segments whose starting joint lies in the stretch, but the pivot: no
-    #                corner, and no place a mesh node must sit (the side runs through)
+    joints: tuple  # segments whose starting joint is in the stretch (a member, or smooth),
+    #                but the pivot: no corner, no place a mesh node must sit
     start: float  # arc length along the loop where the stretch starts
     end: float  # ... and ends (may exceed the loop's length: the stretch wraps)
-    pivot: float  # arc length of the one corner it stands for (flat: its start)
+    pivot: float  # arc length of its middle: where it turns (a concave one's corner)
     pivot_segment: int  # the curve holding the pivot
     pivot_param: float  # its parameter there (0.0: the joint at the curve's start)
     angle: float | None  # interior angle of the whole stretch; None: flat
@@ -93,10 +98,15 @@ def boundary_features(domain, size: float) -> list:
             continue  # a lone circle: no corner to read
         total = float(loop_offsets(loop)[-1])
         turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
-                 or (loop[t[2]].radius < ROUND * size and abs(t[1]) <= ROUND_SWEEP)]
+                 or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)]
         if not turns:
             continue
         gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
+        # A fillet an element long or more is a feature on its own: the corner beside it
+        # is one of the part's, not a detail of the fillet.
+        long = [t[5] - t[4] >= size for t in turns]
+        gaps = [reach if long[k] or long[(k + 1) % len(turns)] else gap
+                for k, gap in enumerate(gaps)]
         if len(turns) > 1 and max(gaps) < reach:
             continue  # the whole loop is one chain: read as it is
         first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
@@ -131,17 +141,15 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     start = first[4]
     end = last[5] if last[5] >= start else last[5] + total
     offsets = loop_offsets(loop)[:-1]
-    inside = [si for si, at in enumerate(offsets)
-              if (at - start) % total <= end - start]
+    members = {t[2] for t in group if t[3] == "joint"}
+    inside = [si for si, at in enumerate(offsets) if (at - start) % total <= end - start
+              and (si in members or not is_corner(interior_angle(loop[si - 1], loop[si])))]
     t_in = loop[first[2] - 1].tangent(1.0) if first[3] == "joint" \
         else loop[first[2]].tangent(0.0)
     t_out = loop[last[2]].tangent(0.0) if last[3] == "joint" else loop[last[2]].tangent(1.0)
-    if quarters == 2:
-        return Feature(li, tuple(inside), start, end, start, first[2],
-                       0.0 if first[3] == "joint" else 0.5, None, np.asarray(t_in, float),
-                       np.asarray(t_out, float))
-    # The corner sits in the stretch's middle, the same place whichever way the loop
-    # runs; on a joint there if the middle is one.
+    # The stretch turns in its middle, the same place whichever way the loop runs (a
+    # mirrored copy runs it the other way); a concave one's corner sits there, on a joint
+    # if the middle is one.
     middle = (start + 0.5 * (end - start)) % total
     offsets = loop_offsets(loop)
     seg = int(np.clip(np.searchsorted(offsets, middle, side="right") - 1, 0, len(loop) - 1))
@@ -150,6 +158,9 @@ def _feature(li, loop, group, total, size) -> Feature | None:
         seg, param = (seg + 1) % len(loop), 0.0
     elif param <= JOINT_TOL:
         param = 0.0
+    if quarters == 2:
+        return Feature(li, tuple(inside), start, end, middle, seg, float(param), None,
+                       np.asarray(t_in, float), np.asarray(t_out, float))
     joints = tuple(si for si in inside if not (param == 0.0 and si == seg))
     return Feature(li, joints, start, end, middle, seg, float(param), angle,
                    np.asarray(t_in, float), np.asarray(t_out, float))
