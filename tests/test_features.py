@@ -79,3 +79,20 @@ def test_the_fillet_corner_is_a_background_node_at_the_arc_middle(mirror, nodes)
     middle = domain.loops[fillet.loop][fillet.pivot_segment].point(fillet.pivot_param)
     corner = mesh.corner_nodes[np.argmax(mesh.corner_angles)]
     assert np.hypot(*(mesh.nodes[corner] - middle)) <= 1e-9 * domain.size
+
+
+def test_a_corner_beside_a_fillet_stays_a_corner():
+    # An L whose short arm ends where its concave fillet (radius 1.5 element sizes) ends:
+    # the fillet is one concave corner, the 90° corner at its end is still the part's.
+    size = 10.0499 / 40  # the shape's default size, near enough
+    r = 1.5 * size
+    mid = [1 + r - r * math.cos(math.radians(45)), 1 + r - r * math.sin(math.radians(45))]
+    loops = [[{"line": [[0, 0], [10, 0]]}, {"line": [[10, 0], [10, 1]]},
+              {"line": [[10, 1], [1 + r, 1]]}, {"arc": [[1 + r, 1], mid, [1, 1 + r]]},
+              {"line": [[1, 1 + r], [0, 1 + r]]}, {"line": [[0, 1 + r], [0, 0]]}]]
+    domain = domain_from_json({"loops": loops})
+    features = boundary_features(domain, default_size(domain))
+    assert summary(features) == [(1, 270.0)]  # the fillet's smooth start joint only
+    mesh = background_mesh(domain, nodes=1000)
+    angles = sorted(round(math.degrees(a), 6) for a in mesh.corner_angles)
+    assert angles == [90.0] * 5 + [270.0]
