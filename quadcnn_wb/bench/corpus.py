@@ -83,7 +83,7 @@ def peer(domain, size: float, repeat: int, limit: float) -> dict:
         with time_limit(limit):
             nodes, quads, boundary, elapsed = gmsh_quasi_structured(domain, size)
         seconds.append(elapsed)
-    n_quads, min_sj, mean_sj, irregular = score(domain, nodes, quads, boundary, size)
+    n_quads, min_sj, mean_sj, irregular = score(domain, nodes, quads, boundary)
     return {"irregular": irregular, "min_sj": min_sj, "mean_sj": mean_sj, "quads": n_quads,
             "time": statistics.median(seconds)}
 

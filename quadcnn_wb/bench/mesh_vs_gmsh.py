@@ -20,11 +20,11 @@ from ..core.pipeline import mesh_domain
 from .common import bundled_examples
 
 
-def score(domain, nodes, quads, boundary, size):
-    """(quads, worst and mean scaled Jacobian, irregular vertices) of a mesh made at
-    element size ``size``, by our own quality rules."""
+def score(domain, nodes, quads, boundary):
+    """(quads, worst and mean scaled Jacobian, irregular vertices) of a mesh, by DESIGN.md's
+    definitions (our own quality code)."""
     sj = scaled_jacobians(nodes, quads)
-    expected = boundary_quads_expected(domain, nodes, boundary, size)
+    expected = boundary_quads_expected(domain, nodes, boundary)
     irregular = len(irregular_vertices(quads, len(nodes), expected))
     return len(quads), float(sj.min()), float(sj.mean()), irregular
 
@@ -53,7 +53,7 @@ def main(argv=None) -> int:
                 domain, size * args.gmsh_size_factor)
             peer_t.append(seconds)
         q = result.quality
-        peer = score(domain, nodes, quads, boundary, size)
+        peer = score(domain, nodes, quads, boundary)
         ours_s, peer_s = statistics.median(ours_t), statistics.median(peer_t)
         print(f"{name:<11} {size:>7.4f} | {q['quads']:>11} {q['min_scaled_jacobian']:>6.3f} "
               f"{q['mean_scaled_jacobian']:>6.3f} {q['irregular_vertices']:>4} "

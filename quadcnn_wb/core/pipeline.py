@@ -184,7 +184,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
             timings["quad_mesh"] += time.perf_counter() - clock
     problem = problem or free_face_problem(partition)
     clock = time.perf_counter()
-    quality = mesh_quality(domain, mesh, size)
+    quality = mesh_quality(domain, mesh)
     timings["quality"] = time.perf_counter() - clock
     timings["total"] = sum(timings.values())
     reference = Reference(domain, background, field, tuple(lines), None, dict(timings))

@@ -26,9 +26,12 @@ turns:
   already gets its singular point or its corner from the field).
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
 a chain longer than MAX_SPAN sizes (a curve stored as a polyline), so a part with no such
-features is read exactly as before.  The field (background.py), its corner streamlines,
-the partition's vertices and the quality measure's expected quads all read the boundary
-through these features, so they agree on where the corners are.
+features is read exactly as before.  The field (background.py), its corner streamlines
+and the partition's vertices read the boundary through these features, so they agree on
+where the corners are.  The quality measure does not: DESIGN.md counts a boundary node as
+irregular by its own interior angle, so a small fillet's corner node, with three quads
+where the boundary is smooth, is one irregular vertex (as the valence-5 point a fillet
+read as a curve needs would be).
 """
 
 from __future__ import annotations

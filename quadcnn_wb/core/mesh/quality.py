@@ -6,37 +6,22 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..input.corners import corner_quads, interior_angle
-from ..input.features import boundary_features
 from .quadmesh import scaled_jacobians
 
 
-def boundary_quads_expected(domain, nodes, boundary, size: float) -> np.ndarray:
-    """Quads a regular boundary node has: input.corners.corner_quads, 2 on smooth stretches,
-    with the boundary read at element size ``size`` (input.features): a step's corners are
-    2, a small concave fillet's node nearest its middle is the corner there."""
+def boundary_quads_expected(domain, nodes, boundary) -> np.ndarray:
+    """Quads a regular boundary node has: input.corners.corner_quads, 2 on smooth stretches."""
     expected = np.where(boundary, 2, 4)
     tree = cKDTree(nodes)
     tol = 1e-9 * domain.size
-    features = boundary_features(domain, size)
-    flat = {(f.loop, si) for f in features for si in f.joints}
-    for li, loop in enumerate(domain.loops):
+    for loop in domain.loops:
         for k, curve in enumerate(loop):
-            if curve.kind == "circle" or (li, k) in flat:
+            if curve.kind == "circle":
                 continue
             dist, node = tree.query(curve.p0)
             if dist <= tol:
                 angle = interior_angle(loop[k - 1], curve)
                 expected[node] = corner_quads(angle)
-    on_boundary = np.nonzero(boundary)[0]
-    for feature in features:
-        if feature.angle is None or not len(on_boundary):
-            continue
-        curve = domain.loops[feature.loop][feature.pivot_segment]
-        pivot = curve.point(feature.pivot_param)
-        near = np.hypot(*(nodes[on_boundary] - pivot).T)
-        k = int(np.argmin(near))
-        if near[k] <= max(tol, 0.5 * curve.length * (feature.pivot_param > 0)):
-            expected[on_boundary[k]] = corner_quads(feature.angle)
     return expected
 
 
@@ -57,10 +42,9 @@ def structured_share(mesh) -> float:
     return float(np.mean(mesh.block_of_quad >= 0)) if len(mesh.quads) else 0.0
 
 
-def mesh_quality(domain, mesh, size: float) -> dict:
-    """DESIGN.md's figures of a mesh made at element size ``size``."""
+def mesh_quality(domain, mesh) -> dict:
     sj = scaled_jacobians(mesh.nodes, mesh.quads)
-    expected = boundary_quads_expected(domain, mesh.nodes, mesh.boundary, size)
+    expected = boundary_quads_expected(domain, mesh.nodes, mesh.boundary)
     irregular = irregular_vertices(mesh.quads, len(mesh.nodes), expected)
     return {
         "min_scaled_jacobian": float(sj.min()) if len(sj) else 0.0,
