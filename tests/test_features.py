@@ -96,3 +96,32 @@ def test_a_corner_beside_a_fillet_stays_a_corner():
     mesh = background_mesh(domain, nodes=1000)
     angles = sorted(round(math.degrees(a), 6) for a in mesh.corner_angles)
     assert angles == [90.0] * 5 + [270.0]
+
+
+def test_the_steps_are_cut_by_the_mesh_within_the_checkers_allowance():
+    import numpy as np
+
+    from quadcnn_wb.bench.meshcheck import check_domain_mesh
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    domain = named_domain("thin wall")
+    mesh = mesh_domain(domain).mesh
+    check_domain_mesh(domain, mesh)  # raises MeshDefect
+    step_corners = [[1, 7], [1, 7.08], [5, 7.08], [5, 7]]
+    nearest = [np.min(np.hypot(*(mesh.nodes - c).T)) for c in step_corners]
+    assert max(nearest) > 1e-3  # a step corner the mesh runs past, not a node of it
+
+
+def test_a_cut_corner_is_allowed_its_triangle_and_no_more():
+    import numpy as np
+
+    from quadcnn_wb.bench.meshcheck import MeshDefect, check_quad_mesh
+
+    nodes = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    quads = np.array([[0, 1, 2, 3]])
+    # A domain vertex 0.2 above the top edge: up to 2 x 0.1 of area may be missing.
+    check_quad_mesh(nodes, quads, 1.15, lambda p: True, [], [[0.5, 1.2]])
+    with pytest.raises(MeshDefect, match="area"):
+        check_quad_mesh(nodes, quads, 1.25, lambda p: True, [], [[0.5, 1.2]])
+    with pytest.raises(MeshDefect, match="area"):
+        check_quad_mesh(nodes, quads, 1.15, lambda p: True, [], [])

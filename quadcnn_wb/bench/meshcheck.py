@@ -50,12 +50,35 @@ def chord_allowance(nodes, arcs, tol) -> float:
     return total
 
 
-def check_quad_mesh(nodes, quads, domain_area, on_boundary, arcs=()):
+def cut_corner_allowance(nodes, boundary_edges, vertices, tol) -> float:
+    """Area a mesh may miss or add where its boundary edges cut across the domain's
+    vertices that hold no mesh node (a step or bump below the element size, read as part
+    of a side): twice the triangle between each such vertex and the boundary edge nearest
+    it (an edge across one vertex cuts off that triangle; across a step's two corners,
+    the two triangles less what they share)."""
+    if not len(vertices) or not boundary_edges:
+        return 0.0
+    a = nodes[[e[0] for e in boundary_edges]]
+    b = nodes[[e[1] for e in boundary_edges]]
+    ab = b - a
+    total = 0.0
+    for v in np.asarray(vertices, dtype=float):
+        if np.min(np.hypot(*(nodes - v).T)) <= tol:
+            continue  # a mesh node sits on it
+        t = np.clip(np.einsum("ij,ij->i", v - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        k = int(np.argmin(np.hypot(*(a + t[:, None] * ab - v).T)))
+        u, w = a[k] - v, b[k] - v
+        total += abs(u[0] * w[1] - u[1] * w[0])  # twice the triangle
+    return total
+
+
+def check_quad_mesh(nodes, quads, domain_area, on_boundary, arcs=None, vertices=()):
     """Raise MeshDefect unless a valid conforming all-quad mesh; returns the boundary edges.
 
     on_boundary(point) -> bool tells whether a point lies on the domain boundary; arcs,
     (center, radius) of the curved boundary pieces, bound the area chords may cut off
-    (without them 1 % of the domain is allowed).
+    (arcs None, for a mesh of unknown curves: 1 % of the domain is allowed), and so do the
+    domain's vertices (cut_corner_allowance).
     """
     _require(quads.ndim == 2 and quads.shape[1] == 4, "not an (n, 4) array of quads")
     _require(quads.min() >= 0 and quads.max() < len(nodes), "a quad refers to no node")
@@ -80,8 +103,10 @@ def check_quad_mesh(nodes, quads, domain_area, on_boundary, arcs=()):
     _require(math.isclose(areas.sum(), enclosed, rel_tol=1e-9),
              "quads overlap (their areas exceed the area they enclose)")
     # ... which differs from the domain only by chords under curved boundaries.
-    allowance = (chord_allowance(nodes, arcs, 1e-9 * math.sqrt(domain_area)) * 1.001 +
-                 1e-9 * domain_area) if arcs else 1e-2 * domain_area
+    tol = 1e-9 * math.sqrt(domain_area)
+    allowance = (chord_allowance(nodes, arcs, tol) * 1.001 + 1e-9 * domain_area
+                 + cut_corner_allowance(nodes, boundary_edges, vertices, tol)) \
+        if arcs is not None else 1e-2 * domain_area
     _require(abs(areas.sum() - domain_area) <= allowance,
              "the quads do not cover the domain's area")
     used = np.unique(quads)
@@ -91,7 +116,8 @@ def check_quad_mesh(nodes, quads, domain_area, on_boundary, arcs=()):
 
 def check_domain_mesh(domain, mesh) -> None:
     """check_quad_mesh for a mesh of a Domain: boundary nodes within 1e-9 of the part's
-    size of its exact curves, chord allowance from its arcs.  Raises MeshDefect."""
+    size of its exact curves, area allowance from its arcs and its vertices.  Raises
+    MeshDefect."""
     tol = 1e-9 * domain.size
     curves = [c for loop in domain.loops for c in loop]
 
@@ -99,4 +125,5 @@ def check_domain_mesh(domain, mesh) -> None:
         return any(np.hypot(*(c.point(c.project(p)) - p)) <= tol for c in curves)
 
     arcs = [(np.asarray(c.center), c.radius) for c in curves if hasattr(c, "radius")]
-    check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs)
+    vertices = [c.p0 for c in curves if getattr(c, "kind", "") != "circle"]
+    check_quad_mesh(mesh.nodes, mesh.quads, domain.area, on_boundary, arcs, vertices)
