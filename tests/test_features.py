@@ -125,3 +125,19 @@ def test_a_cut_corner_is_allowed_its_triangle_and_no_more():
         check_quad_mesh(nodes, quads, 1.25, lambda p: True, [], [[0.5, 1.2]])
     with pytest.raises(MeshDefect, match="area"):
         check_quad_mesh(nodes, quads, 1.15, lambda p: True, [], [])
+
+
+@pytest.mark.parametrize("matrix", [rotation(37), rotation(211, mirror=True),
+                                    rotation(131, 1e-3, mirror=True)],
+                         ids=["turned", "turned+mirrored", "turned+shrunk+mirrored"])
+def test_the_thin_wall_gets_the_same_mesh_in_every_pose(matrix):
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    def signature(result):
+        q = result.quality
+        return result.structured_share, q["blocks"], q["quads"], q["irregular_vertices"]
+
+    loops = OWN_SHAPES["thin wall"][0]
+    base = mesh_domain(domain_from_json({"loops": loops}))
+    moved = domain_from_json(transform_domain({"loops": loops}, matrix, shift=(1e4, -7.0)))
+    assert signature(mesh_domain(moved)) == signature(base) == (1.0, 3, 159, 1)
