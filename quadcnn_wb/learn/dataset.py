@@ -83,7 +83,7 @@ def make_sample(source, seed: int, index: int, nodes: int = 2048):
     if any(line.capped for line in ref.streamlines):
         return None, "a streamline had to be capped"
     try:
-        build_partition(domain, ref.streamlines, mesh.element_size)
+        build_partition(domain, ref.streamlines, mesh.element_size, flat_joints=mesh.flat_joints)
     except PartitionError:
         return None, "partition not four-sided"
     hints = ray_features(mesh.nodes, mesh.triangles, ref.field.theta, field_rays(ref.field),
