@@ -294,15 +294,17 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
         k = at[int(node)]
         corners[k] = (int(node), float(angle), t_in)
         where[(int(mesh.boundary_loop[k]), int(mesh.boundary_segment[k]))] = k
+    # Arc length of every boundary node along its loop, once.
+    offsets = [loop_offsets(loop) for loop in domain.loops]
+    lengths = [np.array([c.length for c in loop]) for loop in domain.loops]
+    along = np.array([offsets[li][si] + t * lengths[li][si] for li, si, t in
+                      zip(mesh.boundary_loop, mesh.boundary_segment, mesh.boundary_param)])
     flat = set()
     for feature in features:
-        loop = domain.loops[feature.loop]
-        offsets = loop_offsets(loop)
-        total = float(offsets[-1])
+        total = float(offsets[feature.loop][-1])
         on_loop = np.nonzero(mesh.boundary_loop == feature.loop)[0]
         segs = mesh.boundary_segment[on_loop]
-        s = offsets[segs] + mesh.boundary_param[on_loop] * np.array(
-            [loop[si].length for si in segs])
+        s = along[on_loop]
         for si in feature.joints:
             flat.add((feature.loop, si))
             corners.pop(where.get((feature.loop, si)), None)
@@ -312,8 +314,7 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
             if len(mine):
                 params = mesh.boundary_param[mine]
                 k = int(mine[np.argmin(np.abs(params - feature.pivot_param))])
-                pivot_s = float(offsets[feature.pivot_segment] + mesh.boundary_param[k]
-                                * loop[feature.pivot_segment].length)
+                pivot_s = float(along[k])
                 corners[k] = (int(mesh.boundary_nodes[k]), float(feature.angle),
                               feature.tangent_in)
         into = (s - feature.start) % total  # arc length into the stretch

@@ -143,9 +143,9 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     first, last = group[0], group[-1]
     start = first[4]
     end = last[5] if last[5] >= start else last[5] + total
-    offsets = loop_offsets(loop)[:-1]
+    offsets = loop_offsets(loop)
     members = {t[2] for t in group if t[3] == "joint"}
-    inside = [si for si, at in enumerate(offsets) if (at - start) % total <= end - start
+    inside = [si for si, at in enumerate(offsets[:-1]) if (at - start) % total <= end - start
               and (si in members or not is_corner(interior_angle(loop[si - 1], loop[si])))]
     t_in = loop[first[2] - 1].tangent(1.0) if first[3] == "joint" \
         else loop[first[2]].tangent(0.0)
@@ -154,16 +154,13 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     # mirrored copy runs it the other way); a concave one's corner sits there, on a joint
     # if the middle is one.
     middle = (start + 0.5 * (end - start)) % total
-    offsets = loop_offsets(loop)
     seg = int(np.clip(np.searchsorted(offsets, middle, side="right") - 1, 0, len(loop) - 1))
     param = (middle - offsets[seg]) / loop[seg].length
     if param >= 1.0 - JOINT_TOL:
         seg, param = (seg + 1) % len(loop), 0.0
     elif param <= JOINT_TOL:
         param = 0.0
-    if quarters == 2:
-        return Feature(li, tuple(inside), start, end, middle, seg, float(param), None,
-                       np.asarray(t_in, float), np.asarray(t_out, float))
-    joints = tuple(si for si in inside if not (param == 0.0 and si == seg))
-    return Feature(li, joints, start, end, middle, seg, float(param), angle,
+    flat = quarters == 2
+    joints = tuple(si for si in inside if flat or not (param == 0.0 and si == seg))
+    return Feature(li, joints, start, end, middle, seg, float(param), None if flat else angle,
                    np.asarray(t_in, float), np.asarray(t_out, float))
