@@ -48,14 +48,7 @@ def test_mesh_is_valid_and_conforming(name):
     assert result.quality["min_scaled_jacobian"] > 0.5
 
 
-# The disk's four valence-3 points come out clustered within 0.1 R of its centre, where a
-# face between them has three corners and is split (two extra irregular vertices); which
-# background mesh gmsh returns decides it (issue 15's T-mesh partition is the cure).
-DISK_SPLIT = pytest.mark.xfail(strict=True, reason="clustered singular points split a face")
-
-
-@pytest.mark.parametrize("name", EXAMPLE_NAMES + [pytest.param(n, marks=DISK_SPLIT)
-                                                  if n == "disk" else n for n in MESHABLE_OWN])
+@pytest.mark.parametrize("name", EXAMPLE_NAMES + MESHABLE_OWN)
 def test_only_the_singular_points_are_irregular(name):
     result = meshed(name)
     # ... and the corners a small concave fillet is read as (input.features): three quads

@@ -117,13 +117,19 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
 
 FINER_BACKGROUND = 4  # times the background nodes of the second try where free faces are left
 FINER_COST = 2.0  # the second try's time, at most about this many times the first's
+FAIR_JACOBIAN = 0.2  # a worst element below this outweighs a higher structured share
 
 
 def _better(first: MeshResult, second: MeshResult) -> bool:
-    def key(r):
-        return (round(r.structured_share, 9), round(r.quality["min_scaled_jacobian"], 9))
+    """More of it in blocks, then the better worst element; but a mesh whose worst
+    element is below FAIR_JACOBIAN loses to one that has none (a near-flat quad costs an
+    analysis more than a few unstructured quads do)."""
+    return _mesh_key(first.mesh) > _mesh_key(second.mesh)
 
-    return key(first) > key(second)
+
+def _mesh_key(mesh) -> tuple:
+    worst = round(float(scaled_jacobians(mesh.nodes, mesh.quads).min()), 9)
+    return (worst >= FAIR_JACOBIAN, round(structured_share(mesh), 9), worst)
 
 
 def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines):

@@ -36,6 +36,7 @@ from .subdivide import split_odd_faces
 
 TURN_TIE = 1e-6  # radians: turns this close to CORNER_TURN are exactly at it
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
+PROMOTED_TURN = math.radians(20)  # a three-cornered face's fourth corner bends at least this
 
 
 # ----------------------------------------------------------------------------------------
@@ -619,6 +620,20 @@ def _lobes(halves, places, h) -> list:
     return lobes
 
 
+def _with_fourth_corner(turns, corner_at):
+    """A three-cornered face whose sides bend somewhere by PROMOTED_TURN or more gets its
+    fourth corner at the sharpest bend (a chamfer's end at a spike's tip, a polyline's
+    kink): one block, whose quads there meet at the boundary's own angle as gmsh's do,
+    instead of three blocks squeezed into the face round an extra irregular vertex.  A tie
+    between two bends is left to the split, so that no pose decides it."""
+    rest = np.setdiff1d(np.arange(len(turns)), corner_at)
+    rest = rest[turns[rest] >= PROMOTED_TURN]
+    if not len(rest):
+        return corner_at
+    top = rest[turns[rest] >= turns[rest].max() - TURN_TIE]
+    return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
+
+
 def _block_of(cycle, half, edges, vertices, h, head):
     reach = 0.5 * h
     turns = []
@@ -646,6 +661,8 @@ def _block_of(cycle, half, edges, vertices, h, head):
         raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
                              f"{fmt(vertices[head(cycle[k])])}: not a four-sided block")
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
+    if len(corner_at) == 3:
+        corner_at = _with_fourth_corner(turns, corner_at)
     if len(corner_at) not in (3, 4, 5):
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
         raise PartitionError(f"a block near {fmt(centre)} has {len(corner_at)} corners "

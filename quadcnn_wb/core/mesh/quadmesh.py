@@ -2,12 +2,13 @@
 by transfinite (Coons) interpolation, then smoothed without ever inverting an element.
 
 Edges are shared by the blocks on both sides, so the mesh is conforming by construction;
-nodes on boundary edges are placed on the exact curves (arc-length spacing) and never
-move.  Free faces (no blocks, see partition.py) get gmsh's unstructured quads on the
-side nodes their neighbours use (free_faces.py); their quads belong to block -1.  Interior
-nodes, including those on streamline edges and at singular points, are smoothed
-(Laplacian) under a guard that undoes any move that would make a quad's scaled
-Jacobian drop below the smaller of its current value and SMOOTH_FLOOR.
+nodes on boundary edges are placed on the exact curves (arc-length spacing) and move only
+along them, where that raises the worst quads (improve.py).  Free faces (no blocks, see
+partition.py) get gmsh's unstructured quads on the side nodes their neighbours use
+(free_faces.py); their quads belong to block -1.  Interior nodes, including those on
+streamline edges and at singular points, are smoothed (Laplacian) under a guard that undoes
+any move that would make a quad's scaled Jacobian drop below the smaller of its current
+value and SMOOTH_FLOOR; then the worst quads get max-min moves (improve.py).
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_fills
+from .improve import BoundarySlide, improve_worst
+from .improve import sj_batch as _sj_batch
 from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
@@ -36,13 +39,15 @@ class QuadMesh:
     free_face_of_quad: np.ndarray = None  # (Q,) the partition's free face a quad fills, or -1
 
 
-def _boundary_edge_points(domain, edge, n: int) -> np.ndarray:
-    """n + 1 points at equal arc length along the exact curve stretches of the edge."""
+def _boundary_edge_points(domain, edge, n: int) -> tuple:
+    """n + 1 points at equal arc length along the exact curve stretches of the edge, with
+    the stretch (piece index) and curve parameter of each."""
     curves = [domain.loops[p.loop][p.segment] for p in edge.pieces]
     lengths = np.array([c.length * abs(p.t1 - p.t0) for c, p in zip(curves, edge.pieces)])
     cum = np.concatenate([[0.0], np.cumsum(lengths)])
     s = np.linspace(0.0, cum[-1], n + 1)
     out = np.empty((n + 1, 2))
+    where = []
     for k, sk in enumerate(s):
         i = int(np.clip(np.searchsorted(cum, sk, side="right") - 1, 0, len(curves) - 1))
         p = edge.pieces[i]
@@ -51,7 +56,29 @@ def _boundary_edge_points(domain, edge, n: int) -> np.ndarray:
         if k == n:
             t = p.t1 if i == len(curves) - 1 else t
         out[k] = curves[i].point(float(t))
-    return out
+        where.append((i, float(t)))
+    return out, where
+
+
+def _slides(domain, partition, layout, counts, ids, where) -> dict:
+    """The boundary nodes that may slide along their curve (see improve.py): every inner
+    node of a boundary edge, bounded by its neighbours on the same curve stretch."""
+    slides = {}
+    for e, (edge, spots) in enumerate(zip(partition.edges, where)):
+        if spots is None:
+            continue
+        nodes = ids[layout.edge_nodes[e]]
+        for k in range(1, len(spots) - 1):
+            i, t = spots[k]
+            piece = edge.pieces[i]
+            same_before, same_after = spots[k - 1][0] == i, spots[k + 1][0] == i
+            slides[int(nodes[k])] = BoundarySlide(
+                curve=domain.loops[piece.loop][piece.segment], t=t,
+                before=int(nodes[k - 1]) if same_before and k > 1 else None,
+                after=int(nodes[k + 1]) if same_after and k < len(spots) - 2 else None,
+                t_before=spots[k - 1][1] if same_before else piece.t0,
+                t_after=spots[k + 1][1] if same_after else piece.t1)
+    return slides
 
 
 def _polyline_points(points: np.ndarray, n: int) -> np.ndarray:
@@ -70,14 +97,17 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
         raise PartitionError("the segment counts merge two boundary nodes or singular points")
     raw = np.zeros((layout.n_nodes, 2))
     raw[: len(partition.vertices)] = partition.vertices
+    where = [None] * len(partition.edges)
     for e, edge in enumerate(partition.edges):
         n = int(counts[e])
         if n == 0:
             continue
-        pts = _boundary_edge_points(domain, edge, n) if edge.is_boundary \
-            else _polyline_points(edge.points, n)
+        if edge.is_boundary:
+            pts, where[e] = _boundary_edge_points(domain, edge, n)
+        else:
+            pts = _polyline_points(edge.points, n)
         raw[layout.edge_nodes[e][1:-1]] = pts[1:-1]
-    # A merged place: the boundary node if it holds one (boundary nodes never move), else
+    # A merged place: the boundary node if it holds one (boundary nodes stay on the boundary), else
     # the mean of what was merged (two side-by-side separatrices meet half-way).
     root = found.parent
     used = np.unique(root)
@@ -143,6 +173,12 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     quads = counter_clockwise_quads(nodes, quads)
     if smoothing:
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
+        if _sj_batch(nodes[quads]).min() > 0:
+            # Boundary nodes slide only in a mesh with no inverted quad: whether a fold
+            # is left (and its blocks freed) is decided as before, alike in every pose,
+            # not by how far a slide happened to rescue it.
+            slides = _slides(domain, partition, layout, counts, ids, where)
+            nodes = improve_worst(nodes, quads, boundary, slides=slides)
     edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
                        for e, e_nodes in enumerate(layout.edge_nodes))
     free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
@@ -301,87 +337,5 @@ def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarr
         moved = float(np.hypot(*(proposal - x).T).max())
         x, quality = proposal, new_quality
         if moved < 1e-12 * span:
-            break
-    return x
-
-
-NEXT_CORNER = np.array([1, 2, 3, 0])
-PREVIOUS_CORNER = np.array([3, 0, 1, 2])
-
-
-def _sj_batch(p) -> np.ndarray:
-    """Scaled Jacobian of quads given as corner arrays (..., 4, 2).
-
-    Corners picked by index, not np.roll: the same numbers, and the max-min moves call
-    this a million times on a big free face (np.roll was a quarter of perforated_plate's
-    meshing time)."""
-    a = p[..., NEXT_CORNER, :] - p
-    b = p[..., PREVIOUS_CORNER, :] - p
-    cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    norm = np.hypot(a[..., 0], a[..., 1]) * np.hypot(b[..., 0], b[..., 1])
-    return np.min(np.where(norm > 0, cross / np.maximum(norm, 1e-300), -1.0), axis=-1)
-
-
-def _visiting_order(x, quads, sj, vertices):
-    """Worst first, then nearest the middle: geometry, not numbering, decides (the node
-    numbers of a turned copy differ)."""
-    worst_around = np.full(len(x), np.inf)
-    np.minimum.at(worst_around, quads.ravel(), np.repeat(sj, 4))
-    span = float(np.ptp(x, axis=0).max()) or 1.0
-    middle = np.hypot(*(x[vertices] - x.mean(axis=0)).T) / span
-    keys = np.lexsort((np.round(middle, 9), worst_around[vertices]))
-    return vertices[keys]
-
-
-def _reference_direction(offsets, reach):
-    """(cos, sin) of the direction the compass is measured from: towards the mean of the
-    surrounding corners, or (a symmetric star) towards the farthest corner."""
-    mean = offsets.mean(axis=0)
-    if np.hypot(*mean) > 1e-6 * reach:
-        return mean / np.hypot(*mean)
-    far = offsets[int(np.argmax(np.round(np.hypot(*offsets.T) / reach, 9)))]
-    return far / np.hypot(*far)
-
-
-def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02) -> np.ndarray:
-    """Raise the worst elements: move free nodes of the worst quads to maximise the
-    smallest scaled Jacobian around them (compass search, all trials of a node at once).
-
-    Laplacian smoothing evens out sizes but not angles; at a singular point the block
-    corners meet at uneven angles and only a max-min move fixes them.
-    """
-    x = nodes.copy()
-    order = np.argsort(quads.ravel(), kind="stable")
-    starts = np.searchsorted(quads.ravel()[order], np.arange(len(x) + 1))
-    angles = np.linspace(0, 2 * np.pi, 8, endpoint=False)
-    compass = np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    steps = np.concatenate([0.1 * compass, 0.03 * compass])
-    for _ in range(passes):
-        # Rounded and stable: a turned copy of the mesh visits the same nodes in the same
-        # order (rounding noise must not reorder near-ties).
-        sj = np.round(scaled_jacobians(x, quads), 12)
-        worst = np.argsort(sj, kind="stable")[: max(4, int(share * len(quads)))]
-        improved = False
-        for v in _visiting_order(x, quads, sj, np.unique(quads[worst].ravel())):
-            if fixed[v]:
-                continue
-            around = quads[order[starts[v]:starts[v + 1]] // 4]
-            corners = x[around]  # (k, 4, 2)
-            current = _sj_batch(corners).min()
-            reach = np.hypot(*(corners.reshape(-1, 2) - x[v]).T).max()
-            # Compass directions measured from an edge of the node, not from the axes, so
-            # that a turned or mirrored mesh tries the turned or mirrored moves.
-            c, s = _reference_direction(corners.reshape(-1, 2) - x[v], reach)
-            frame = np.array([[c, -s], [s, c]])
-            trial = x[v] + reach * steps @ frame.T  # (T, 2)
-            batch = np.repeat(corners[None], len(trial), axis=0)
-            mask = around == v
-            batch[:, mask] = trial[:, None, :]
-            values = _sj_batch(batch).min(axis=1)
-            k = int(np.argmax(values))
-            if values[k] > current + 1e-9:
-                x[v] = trial[k]
-                improved = True
-        if not improved:
             break
     return x
