@@ -192,3 +192,29 @@ def test_the_finer_background_is_skipped_when_it_would_not_fit_the_time_allowed(
     result = mesh_domain(domain, seconds=1e-3)
     assert result.structured_share < 1.0 and "other_background" not in result.timings
     assert result.reference.mesh.n_nodes < 2100
+
+
+def test_a_thin_spike_is_one_column_of_quads_as_good_as_its_tip_allows():
+    """tailwheel_gusset's spike (1 mm wide, a 0.35 mm chamfer at its tip) is a three-
+    cornered face: it gets its fourth corner at the chamfer's upper end, so the worst
+    quad there has the boundary's own angle (gmsh's best), not three blocks squeezed
+    round an extra irregular vertex (0.25)."""
+    import numpy as np
+
+    result = meshed("tailwheel_gusset")
+    outer = result.domain.loops[0]
+    ends = [k for k in range(len(outer))
+            if np.allclose(outer[k].p1, [-32.26763784, 1.00433975], atol=1e-6)]
+    assert len(ends) == 1
+    a, b = outer[ends[0]].tangent(1.0), outer[(ends[0] + 1) % len(outer)].tangent(0.0)
+    bend_sine = abs(a[0] * b[1] - a[1] * b[0]) / np.hypot(*a) / np.hypot(*b)
+    assert result.structured_share == 1.0
+    assert result.quality["min_scaled_jacobian"] >= bend_sine - 1e-9
+    # Irregular: the singular points, the small concave fillet read as a corner, and the
+    # chamfer's end, a 158° vertex with the one quad of a block corner.
+    fillets = sum(f.angle is not None for f in boundary_features(result.domain, result.size))
+    assert result.quality["irregular_vertices"] == \
+        len(result.reference.field.singularities) + fillets + 1
+    mesh = result.mesh
+    at_end = np.nonzero(np.hypot(*(mesh.nodes - outer[ends[0]].p1).T) < 1e-9)[0]
+    assert len(at_end) == 1 and np.sum(mesh.quads == at_end[0]) == 1

@@ -259,3 +259,23 @@ def test_segment_counts_without_a_proven_optimum_are_refused_not_taken():
         quantize(result.partition, result.size, time_limit=1e-9)
     assert not isinstance(refused.value, InfeasibleCounts)  # not mistaken for "no counts"
     assert "no proven optimum" in str(refused.value)
+
+
+def test_a_boundary_node_slides_along_its_curve_to_square_its_quads():
+    """A side node left at 0.8 of a straight side skews both quads; the max-min move
+    slides it along the side (never off it) until they are square again."""
+    from quadcnn_wb.core.input.curves import Line
+    from quadcnn_wb.core.mesh.improve import BoundarySlide, improve_worst, sj_batch
+
+    nodes = np.array([[0, 0], [1.6, 0], [2, 0], [0, 1], [1, 1], [2, 1]], dtype=float)
+    quads = np.array([[0, 1, 4, 3], [1, 2, 5, 4]])
+    side = Line(np.array([0.0, 0.0]), np.array([2.0, 0.0]))
+    slides = {1: BoundarySlide(curve=side, t=0.8, before=None, after=None,
+                               t_before=0.0, t_after=1.0)}
+    fixed = np.ones(len(nodes), dtype=bool)
+    assert improve_worst(nodes, quads, fixed) == pytest.approx(nodes)  # fixed: stays
+    moved = improve_worst(nodes, quads, fixed, passes=40, slides=slides)
+    assert moved[1, 1] == 0.0 and abs(moved[1, 0] - 1.0) < 0.05
+    assert slides[1].t == pytest.approx(moved[1, 0] / 2.0)
+    assert sj_batch(moved[quads]).min() > 0.99 > sj_batch(nodes[quads]).min()
+    assert moved[[0, 2, 3, 4, 5]] == pytest.approx(nodes[[0, 2, 3, 4, 5]])
