@@ -185,6 +185,35 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
     assert finer.timings["total"] >= finer.timings["other_background"] > 0
 
 
+@pytest.mark.parametrize("name, finished", [("bracket_plate", [8192]),
+                                             ("sketch_gasket", [8192, 2048])])
+def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_some(
+        monkeypatch, name, finished):
+    # The freeing rounds and unstructured fills of a layout that leaves free faces cost
+    # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
+    # it: bracket_plate's finer layout is all blocks, sketch_gasket's is not.
+    from quadcnn_wb.core import pipeline
+
+    calls = []
+    real = pipeline._mesh_on_background
+
+    def counted(domain, size, nodes, *args, stop_at_free=False):
+        try:
+            result = real(domain, size, nodes, *args, stop_at_free=stop_at_free)
+        except pipeline.LeavesFreeFaces:
+            calls.append(("stopped", nodes))
+            raise
+        calls.append(("finished", nodes))
+        return result
+
+    monkeypatch.setattr(pipeline, "_mesh_on_background", counted)
+    result = mesh_domain(load_domain(CORPUS / PARTS[name]["file"]))
+    assert calls[0] == ("stopped", 2048)
+    assert [n for what, n in calls[1:] if what == "finished"] == finished
+    assert len(calls) == 1 + len(finished)
+    assert result.timings["other_background"] > 0
+
+
 def test_the_finer_background_is_skipped_when_it_would_not_fit_the_time_allowed():
     # The command line's --time-limit is a hard ceiling: a second layout that cannot fit
     # in it is not started (perforated_plate took 174 s with it, over the default 120 s).

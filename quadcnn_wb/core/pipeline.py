@@ -97,18 +97,37 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     size = default_size(domain) if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
-    result = _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines)
-    if method != "numerical" or result.structured_share >= 1.0 or FINER_BACKGROUND <= 1:
-        return result
-    if seconds is not None and (1.0 + FINER_COST) * result.timings["total"] > seconds:
-        return result  # no time for it: a mesh now beats a better one past the limit
+    if method != "numerical" or FINER_BACKGROUND <= 1:
+        return _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines)
     # Free faces left: the field may not resolve the part's small features (a gear's
     # roots, bolt holes of a few elements, notches) on `nodes` background nodes.  The
     # layout on a finer background is tried too, and the better mesh kept: more of it in
     # blocks, then the better worst element.  Both runs are decided by the geometry
-    # alone, so every copy of the part picks the same one.
+    # alone, so every copy of the part picks the same one.  A first layout that leaves
+    # free faces is not finished (its freeing rounds and unstructured fills cost more
+    # than the finer try) unless the finer one leaves free faces too.
+    try:
+        result = _mesh_on_background(domain, size, nodes, method, smoothing,
+                                     learned_streamlines, stop_at_free=True)
+        spent = result.timings["total"]
+    except LeavesFreeFaces as exc:
+        result, spent = None, exc.seconds
+    if result is not None and result.structured_share >= 1.0:
+        return result
+    if seconds is not None and (1.0 + FINER_COST) * spent > seconds:
+        # No time for it: a mesh now beats a better one past the limit.
+        return result or _mesh_on_background(domain, size, nodes, method, smoothing,
+                                             learned_streamlines)
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
+    if result is None and _mesh_key(finer.mesh)[:2] == (True, 1.0):  # nothing to beat it
+        finer.timings["other_background"] = spent
+        finer.timings["total"] += spent
+        return finer
+    if result is None:
+        result = _mesh_on_background(domain, size, nodes, method, smoothing,
+                                     learned_streamlines)
+        result.timings["total"] += spent
     best, other = (finer, result) if _better(finer, result) else (result, finer)
     best.timings["other_background"] = other.timings["total"]
     best.timings["total"] += other.timings["total"]
@@ -132,8 +151,18 @@ def _mesh_key(mesh) -> tuple:
     return (worst >= FAIR_JACOBIAN, round(structured_share(mesh), 9), worst)
 
 
-def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines):
-    """mesh_domain on a background of ``nodes`` nodes."""
+class LeavesFreeFaces(Exception):
+    """The first layout leaves free faces (``stop_at_free``): not worth finishing yet."""
+
+    def __init__(self, seconds: float):
+        super().__init__("the layout leaves free faces")
+        self.seconds = seconds
+
+
+def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines,
+                        stop_at_free=False):
+    """mesh_domain on a background of ``nodes`` nodes; LeavesFreeFaces, with the seconds
+    spent, if ``stop_at_free`` and the first partition has faces that are no blocks."""
     timings = {}
     # The cnn path needs the node count its network was trained for; tracing does not.
     background, field = background_and_field(domain, nodes, timings,
@@ -154,7 +183,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
         try:
             cuts, partition, counts, mesh = blocks_and_mesh(
                 domain, background, field, lines, size, smoothing, timings,
-                allow_free=method != "cnn")
+                allow_free=method != "cnn", stop_at_free=stop_at_free)
         except PartitionError:
             if method != "cnn":
                 raise
@@ -210,14 +239,15 @@ FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable f
 
 
 def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
-                    allow_free=True, worst_allowed=MIN_VALID_JACOBIAN):
+                    allow_free=True, worst_allowed=MIN_VALID_JACOBIAN, stop_at_free=False):
     """Partition, segment counts and the mesh, checked; PartitionError when no valid mesh
     can be had from these streamlines.  Faces that are no blocks, and blocks whose map
     gives a degenerate element, get unstructured quads (free faces); a free face that
     cannot be filled (it pinches or touches itself) loses its streamline edges, merging
     it with its neighbours, and the partition is built again.  Not when ``allow_free`` is
     False (the cnn path: its lines are then not trusted).  ``worst_allowed``: the scaled
-    Jacobian a mesh must beat (lower only where the alternative is a folded mesh)."""
+    Jacobian a mesh must beat (lower only where the alternative is a folded mesh).
+    ``stop_at_free``: raise LeavesFreeFaces as soon as the first partition has free faces."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
     dissolve, freed = frozenset(), set()
     clock = time.perf_counter()
@@ -239,6 +269,8 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         partition = free_blocks(partition, unequal, "no segment counts make its opposite "
                                                     "sides equal")
         timings["quantization"] += time.perf_counter() - clock
+        if stop_at_free and partition.free_faces:
+            raise LeavesFreeFaces(sum(timings.values()))
         clock = time.perf_counter()
         try:
             mesh = build_quad_mesh(domain, partition, counts, smoothing=smoothing)
