@@ -21,8 +21,7 @@ from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_fills
-from .improve import BoundarySlide, improve_worst
-from .improve import sj_batch as _sj_batch
+from .improve import BoundarySlide, improve_worst, sj_batch
 from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
@@ -173,7 +172,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     quads = counter_clockwise_quads(nodes, quads)
     if smoothing:
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
-        if _sj_batch(nodes[quads]).min() > 0:
+        if sj_batch(nodes[quads]).min() > 0:
             # Boundary nodes slide only in a mesh with no inverted quad: whether a fold
             # is left (and its blocks freed) is decided as before, alike in every pose,
             # not by how far a slide happened to rescue it.
@@ -214,9 +213,9 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
         points = np.vstack([xy[every], interior])
         if signed_areas(points, local).sum() < 0:
             local = local[:, ::-1]  # one orientation for all: a folded quad stays negative
-        if _sj_batch(points[local]).min() <= 0:
+        if sj_batch(points[local]).min() <= 0:
             points = _untangled(points, local, len(every))
-        if _sj_batch(points[local]).min() > 0:
+        if sj_batch(points[local]).min() > 0:
             break
     else:
         raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
@@ -244,11 +243,11 @@ def _untangled(points, local, n_ring) -> np.ndarray:
     # Plain Laplacian first (a fold where a curved side bulges into gmsh's centre nodes
     # needs them pulled towards their neighbours), kept only where it does better.
     relaxed = _laplacian(points, local, fixed, UNTANGLE_PASSES)
-    if _sj_batch(relaxed[local]).min() > _sj_batch(points[local]).min():
+    if sj_batch(relaxed[local]).min() > sj_batch(points[local]).min():
         points = relaxed
     # Only around the folds (a big face has thousands of quads that are fine): the quads
     # within UNTANGLE_RINGS of an inverted one move, the nodes on that patch's rim stay.
-    near = _sj_batch(points[local]) <= 0
+    near = sj_batch(points[local]) <= 0
     if not near.any():
         return points
     for _ in range(UNTANGLE_RINGS):
@@ -307,7 +306,7 @@ def _coons(bottom, top, left, right) -> np.ndarray:
 
 def scaled_jacobians(nodes, quads) -> np.ndarray:
     """DESIGN.md: per quad, min over corners of (a x b) / (|a||b|), a to next, b to previous."""
-    return _sj_batch(nodes[quads])
+    return sj_batch(nodes[quads])
 
 
 def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarray:
