@@ -17,6 +17,7 @@ from .field.pairs import without_cancelling_pairs
 from .field.reference import Reference, background_and_field
 from .input.domain import Domain
 from .input.pose import default_size
+from .input.small_holes import squared_holes
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import build_partition
@@ -97,6 +98,16 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     size = default_size(domain) if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
+    # Small round holes are squares to the layout only (input.small_holes): the result
+    # holds the part as given, whose curves the exports name.
+    result = _best_layout(squared_holes(domain, size), size, nodes, method, smoothing,
+                          learned_streamlines, seconds)
+    result.domain = domain
+    return result
+
+
+def _best_layout(domain, size, nodes, method, smoothing, learned_streamlines, seconds):
+    """mesh_domain's layout, on a finer background too where the first leaves free faces."""
     if method != "numerical" or FINER_BACKGROUND <= 1:
         return _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines)
     # Free faces left: the field may not resolve the part's small features (a gear's

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .corners import interior_angle, is_corner, nearest_quarters
+from .small_holes import SMALL_HOLE, is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
@@ -97,6 +98,9 @@ def boundary_features(domain, size: float) -> list:
     out = []
     reach = FEATURE * size
     for li, loop in enumerate(domain.loops):
+        if is_quartered(loop) and 2.0 * loop[0].radius < SMALL_HOLE * size:
+            out.extend(_square_corners(li, loop))  # a small round hole (small_holes.py)
+            continue
         if len(loop) < 2:
             continue  # a lone circle: no corner to read
         total = float(loop_offsets(loop)[-1])
@@ -124,6 +128,16 @@ def boundary_features(domain, size: float) -> list:
             if feature is not None:
                 out.append(feature)
     return out
+
+
+def _square_corners(li, loop) -> list:
+    """A quartered hole's four concave corners, one at each quarter arc's middle; the
+    smooth joints between the arcs (where the square's sides touch the circle) are flat."""
+    offsets = loop_offsets(loop)
+    return [Feature(li, (k,), float(offsets[k]), float(offsets[k + 1]),
+                    float(0.5 * (offsets[k] + offsets[k + 1])), k, 0.5, 1.5 * math.pi,
+                    np.asarray(arc.tangent(0.0), float), np.asarray(arc.tangent(1.0), float))
+            for k, arc in enumerate(loop)]
 
 
 def _feature(li, loop, group, total, size) -> Feature | None:
