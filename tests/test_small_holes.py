@@ -71,3 +71,13 @@ def test_a_turned_copy_turns_its_squares_alike(degrees, mirror, scale):
         distance = np.hypot(*(got[:, None, :] - expected[None, :, :]).transpose(2, 0, 1))
         assert distance.min(axis=1).max() < 1e-9 * 100 * scale
         assert math.isclose(moved.loops[loop][0].radius, base.loops[loop][0].radius * scale)
+
+
+@pytest.mark.parametrize("outer_radius, squared", [(3.0, False), (4.0, True)])
+def test_a_hole_in_a_boss_thinner_than_an_element_stays_round(outer_radius, squared):
+    # A 4 mm hole at 1.5 mm elements is small; in a boss whose wall is 1 mm its ring of
+    # quads follows the boss (engine_top's bosses), in a 2 mm wall it is a square.
+    data = {"loops": [[{"circle": {"center": [0, 0], "radius": outer_radius}}],
+                      [{"circle": {"center": [0, 0], "radius": 2.0}}]]}
+    domain = squared_holes(domain_from_json(data), 1.5)
+    assert is_quartered(domain.loops[1]) is squared

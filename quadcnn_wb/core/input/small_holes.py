@@ -1,4 +1,4 @@
-"""Round holes below the element size, read as squares at the mesh's scale.
+"""Round holes of a few elements across, read as squares at the mesh's scale.
 
 A bolt hole of an element or two across cannot be followed by the mesh, and read as a
 circle it bends the cross field round it into four valence-3 singular points, a ring of
@@ -10,7 +10,8 @@ under SMALL_HOLE sizes becomes four quarter arcs, each read as one concave corne
 middle (input.features), turned to the field the surrounding boundary imposes there: the
 mean of its tangents' quarter-turn directions, weighted by the inverse fourth power of
 the distance (the field near a hole follows the nearest boundary, and a weighted mean has
-no ties for round-off to break, where a nearest point may).
+no ties for round-off to break, where a nearest point may).  Not a hole in a boss whose
+wall is thinner than an element: its rings of quads follow the boss.
 """
 
 from __future__ import annotations
@@ -23,8 +24,9 @@ import numpy as np
 from .curves import Arc
 from .pose import canonical_pose
 
-SMALL_HOLE = 2.0  # element sizes: a round hole of a smaller diameter is read as a square
+SMALL_HOLE = 3.0  # element sizes: a round hole of a smaller diameter is read as a square
 SAMPLES = 64  # points per curve for the surrounding boundary's direction
+CONCENTRIC = 1e-3  # radii: arcs whose centres are this close are concentric
 CANCELLED = 1e-6  # a weighted mean direction this short (of the weights) is none
 
 
@@ -47,12 +49,22 @@ def squared_holes(domain, size: float):
         if len(loop) != 1 or not isinstance(loop[0], Arc) or not loop[0].is_full:
             continue
         circle = loop[0]
-        if 2.0 * circle.radius >= SMALL_HOLE * size:
+        if 2.0 * circle.radius >= SMALL_HOLE * size or _in_thin_boss(domain, li, circle, size):
             continue
         theta = _field_direction(domain, li, circle.center)
         loops[li] = _quarters(circle, theta)
         changed = True
     return dataclasses.replace(domain, loops=tuple(loops)) if changed else domain
+
+
+def _in_thin_boss(domain, hole: int, circle: Arc, size: float) -> bool:
+    """Whether an arc of another loop round the same centre lies within a size of the
+    hole's rim: a boss's wall thinner than an element, which its rings of quads follow
+    (squared, engine_top's bosses sent corner streamlines into a 0.5-element wall)."""
+    tol = CONCENTRIC * circle.radius
+    return any(isinstance(c, Arc) and np.hypot(*(c.center - circle.center)) <= tol
+               and c.radius < circle.radius + size
+               for li, loop in enumerate(domain.loops) if li != hole for c in loop)
 
 
 def _field_direction(domain, hole: int, centre) -> float:
