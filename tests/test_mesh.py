@@ -290,3 +290,24 @@ def test_a_boundary_node_slides_along_its_curve_until_its_quads_are_fair():
     fair[1, 0] = 1.2  # both quads above SLIDE_BELOW already: the node stays
     assert sj_batch(fair[quads]).min() >= SLIDE_BELOW
     assert improve_worst(fair, quads, fixed, slides=slides_at(0.6)) == pytest.approx(fair)
+
+
+def test_of_two_layouts_a_near_flat_quad_outweighs_a_higher_structured_share():
+    """mesh_domain keeps the better of two backgrounds' meshes: more of it in blocks,
+    then the better worst element, but one with a quad under FAIR_JACOBIAN loses."""
+    from quadcnn_wb.core.mesh.quadmesh import QuadMesh
+    from quadcnn_wb.core.pipeline import FAIR_JACOBIAN, _mesh_key
+
+    def strip(top_shift, blocks):
+        # Two quads side by side; shifting the top middle node skews both.
+        nodes = np.array([[0, 0], [1, 0], [2, 0], [0, 1], [1 + top_shift, 1], [2, 1]], float)
+        quads = np.array([[0, 1, 4, 3], [1, 2, 5, 4]])
+        return QuadMesh(nodes=nodes, quads=quads, block_of_quad=np.array(blocks),
+                        boundary=np.ones(6, bool), edge_nodes=())
+
+    all_blocks_fine = strip(0.3, [0, 1])
+    all_blocks_sliver = strip(4.0, [0, 1])
+    half_blocks_fair = strip(0.5, [0, -1])
+    assert _mesh_key(all_blocks_sliver)[2] < FAIR_JACOBIAN < _mesh_key(half_blocks_fair)[2]
+    assert _mesh_key(half_blocks_fair) > _mesh_key(all_blocks_sliver)
+    assert _mesh_key(all_blocks_fine) > _mesh_key(half_blocks_fair)
