@@ -4,13 +4,14 @@
 
 The families are the shapes the method is built for, so every member should come out
 fully block-structured, valid (bench.meshcheck, which shares no code with the pipeline)
-and with no irregular vertex but the field's singular points.  Printed per family: how
-many members did, the mean share of quads in blocks, the members with extra irregular
-vertices, the worst element, the median and slowest time, and the first few that did not
-(with the pipeline's reason), so a failure can be reproduced by its index.  With --poses
-every member is also meshed turned by odd angles, moved by 1e4 of its size, mirrored and
-rescaled by 1e-3 and 1e3 (POSES), and the members whose block count, quad count and
-irregular vertices are the same in every pose are counted ("same in poses").
+and with no irregular vertex but the field's singular points (and the corners the layout
+reads where the boundary is smooth: small concave fillets, small round holes' squares).
+Printed per family: how many members did, the mean share of quads in blocks, the members
+with extra irregular vertices, the worst element, the median and slowest time, and the
+first few that did not (with the pipeline's reason), so a failure can be reproduced by
+its index.  With --poses every member is also meshed turned by odd angles, moved by 1e4
+of its size, mirrored and rescaled by 1e-3 and 1e3 (POSES), and the members whose block
+count, quad count and irregular vertices are the same in every pose are counted ("same in poses").
 """
 
 from __future__ import annotations
@@ -68,9 +69,18 @@ def run_member(name: str, seed: int, index: int, poses: bool = False) -> dict:
             "share": result.structured_share, "problem": result.problem,
             "min_sj": result.quality["min_scaled_jacobian"],
             "extra_irregular": result.quality["irregular_vertices"]
-            - len(result.reference.field.singularities),
+            - len(result.reference.field.singularities) - _feature_corners(result),
             "same_in_poses": same_in_every_pose(family(name).build(params), result)
             if poses else None}
+
+
+def _feature_corners(result) -> int:
+    """Corners the layout reads where the boundary is smooth (a small concave fillet, a
+    small round hole's square: input.features), irregular by DESIGN.md's count."""
+    from ..core.input.features import boundary_features
+
+    return sum(f.angle is not None
+               for f in boundary_features(result.reference.domain, result.size))
 
 
 def _packed(args):
