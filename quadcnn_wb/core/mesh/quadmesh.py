@@ -59,7 +59,7 @@ def _boundary_edge_points(domain, edge, n: int) -> tuple:
     return out, where
 
 
-def _slides(domain, partition, layout, counts, ids, where) -> dict:
+def _slides(domain, partition, layout, ids, where) -> dict:
     """The boundary nodes that may slide along their curve (see improve.py): every inner
     node of a boundary edge, bounded by its neighbours on the same curve stretch."""
     slides = {}
@@ -176,7 +176,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
             # Boundary nodes slide only in a mesh with no inverted quad: whether a fold
             # is left (and its blocks freed) is decided as before, alike in every pose,
             # not by how far a slide happened to rescue it.
-            slides = _slides(domain, partition, layout, counts, ids, where)
+            slides = _slides(domain, partition, layout, ids, where)
             nodes = improve_worst(nodes, quads, boundary, slides=slides)
     edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
                        for e, e_nodes in enumerate(layout.edge_nodes))
