@@ -121,11 +121,14 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # two quad counts (the field wound at them as round-off had it, seeding singular points);
 # motor_c_plate, sketch_gear and engine_top: steps and fillets below the element size
 # (input.features; the gear's root fillets and engine_top's are concave corners at the
-# default size, and a mirrored copy must read each stretch the same way round).
+# default size, and a mirrored copy must read each stretch the same way round);
+# nist_ctc01_plate and anc101_flange: bolt holes read as squares (input.small_holes),
+# whose corners a turned or mirrored copy must place alike.
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
-                                  "motor_c_plate", "sketch_gear", "engine_top"])
+                                  "motor_c_plate", "sketch_gear", "engine_top",
+                                  "nist_ctc01_plate", "anc101_flange"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 
