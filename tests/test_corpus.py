@@ -257,3 +257,30 @@ def test_a_thin_spike_is_one_column_of_quads_as_good_as_its_tip_allows():
     mesh = result.mesh
     at_end = np.nonzero(np.hypot(*(mesh.nodes - outer[ends[0]].p1).T) < 1e-9)[0]
     assert len(at_end) == 1 and np.sum(mesh.quads == at_end[0]) == 1
+
+
+def test_blocks_given_up_once_are_not_posed_to_the_program_again(monkeypatch):
+    # nist_ctc04_plate at its default size on 2048 background nodes: the freeing rounds
+    # rebuild the partition several times; a block whose sides no counts balance is
+    # given up before the next round's program (which is slow while it may give blocks
+    # up), so no round returns one an earlier round did.
+    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core.input.small_holes import squared_holes
+
+    rounds = []
+    real = pipeline.quantize_freeing
+
+    def recorded(partition, size):
+        counts, unequal = real(partition, size)
+        rounds.append({pipeline._block_key(partition, b) for b in unequal})
+        return counts, unequal
+
+    monkeypatch.setattr(pipeline, "quantize_freeing", recorded)
+    domain = load_domain(CORPUS / PARTS["nist_ctc04_plate"]["file"])
+    size = pipeline.default_size(domain)
+    result = pipeline._mesh_on_background(squared_holes(domain, size), size, 2048,
+                                          "numerical", True, None)
+    assert len(rounds) > 1 and rounds[0]
+    for k in range(1, len(rounds)):
+        assert not rounds[k] & set().union(*rounds[:k])
+    assert 0.0 < result.structured_share < 1.0

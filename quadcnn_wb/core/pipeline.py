@@ -246,6 +246,7 @@ def _t_mesh(domain, background, lines) -> tuple:
     return stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
 
 
+UNBALANCED = "no segment counts make its opposite sides equal"
 FREEING_ROUNDS = 12  # rebuilds that free folded blocks or merge an unfillable free face
 
 
@@ -260,7 +261,7 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     Jacobian a mesh must beat (lower only where the alternative is a folded mesh).
     ``stop_at_free``: raise LeavesFreeFaces as soon as the first partition has free faces."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
-    dissolve, freed = frozenset(), set()
+    dissolve, freed, unbalanced = frozenset(), set(), set()
     clock = time.perf_counter()
     cuts = connecting_cuts(domain, background, field, lines)  # the same in every round
     timings["partition"] += time.perf_counter() - clock
@@ -275,10 +276,16 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         if partition.free_faces and not allow_free:
             raise PartitionError(partition.free_faces[0].reason)
         clock = time.perf_counter()
+        # Blocks an earlier round's counts gave up are given up before the program: the
+        # one that may give blocks up is slow on a big partition (perforated_plate: 3 to
+        # 10 s a solve), and the rounds would pose it again for the same blocks.
+        partition = free_blocks(partition, [k for k in range(len(partition.blocks))
+                                            if _block_key(partition, k) in unbalanced],
+                                UNBALANCED)
         counts, unequal = quantize_freeing(partition, size) if allow_free \
             else (quantize(partition, size), [])
-        partition = free_blocks(partition, unequal, "no segment counts make its opposite "
-                                                    "sides equal")
+        unbalanced |= {_block_key(partition, b) for b in unequal}
+        partition = free_blocks(partition, unequal, UNBALANCED)
         timings["quantization"] += time.perf_counter() - clock
         if stop_at_free and partition.free_faces:
             raise LeavesFreeFaces(sum(timings.values()))
