@@ -194,12 +194,14 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
 
 
 @pytest.mark.parametrize("name, finished", [("sketch_slot_plate", [8192]),
+                                             ("nist_ctc04_plate", [8192]),
                                              ("crank_arm_web", [8192, 2048])])
 def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_some(
         monkeypatch, name, finished):
     # The freeing rounds and unstructured fills of a layout that leaves free faces cost
     # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
-    # it: sketch_slot_plate's finer layout is all blocks, crank_arm_web's is not.
+    # it: sketch_slot_plate's finer layout is all blocks, nist_ctc04_plate's 97.5 % of
+    # it (GOOD_ENOUGH), crank_arm_web's 37 %.
     from quadcnn_wb.core import pipeline
 
     calls = []
