@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 
 from quadcnn_wb.core.input.domain import DomainError
-from quadcnn_wb.core.input.features import boundary_features
 from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.pipeline import free_edges_on_boundary, mesh_domain, tiles_exactly
 
@@ -78,9 +77,8 @@ def test_every_face_is_block_structured(name):
     assert result.structured_share == 1.0, result.problem
     # Irregular: the field's singular points, the corners small concave fillets are read
     # as (input.features: three quads where the boundary is smooth), and a few to spare.
-    # (The layout's domain: a small round hole's square has four such corners.)
-    fillets = sum(f.angle is not None
-                  for f in boundary_features(result.reference.domain, result.size))
+    # (A small round hole's square has four such corners.)
+    fillets = result.feature_corners
     assert result.quality["irregular_vertices"] <= \
         len(result.reference.field.singularities) + fillets + 4
 
@@ -186,8 +184,7 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
     finer = mesh_domain(domain)
     assert finer.structured_share == 1.0, finer.problem
     assert finer.reference.mesh.n_nodes > 3 * coarse.reference.mesh.n_nodes
-    corners = sum(f.angle is not None
-                  for f in boundary_features(finer.reference.domain, finer.size))
+    corners = finer.feature_corners
     assert finer.quality["irregular_vertices"] <= \
         len(finer.reference.field.singularities) + corners
     assert finer.timings["total"] >= finer.timings["other_background"] > 0
@@ -251,9 +248,8 @@ def test_a_thin_spike_is_one_column_of_quads_as_good_as_its_tip_allows():
     assert result.quality["min_scaled_jacobian"] >= bend_sine - 1e-9
     # Irregular: the singular points, the small concave fillet read as a corner, and the
     # chamfer's end, a 158° vertex with the one quad of a block corner.
-    # (The layout's domain: a small round hole's square has four such corners.)
-    fillets = sum(f.angle is not None
-                  for f in boundary_features(result.reference.domain, result.size))
+    # (A small round hole's square has four such corners.)
+    fillets = result.feature_corners
     assert result.quality["irregular_vertices"] == \
         len(result.reference.field.singularities) + fillets + 1
     mesh = result.mesh

@@ -14,7 +14,6 @@ from conftest import EXAMPLE_NAMES, SHARED_EXAMPLES, run_cli
 from shapes import OWN_SHAPES, named_domain
 
 from quadcnn_wb.bench.meshcheck import check_quad_mesh
-from quadcnn_wb.core.input.features import boundary_features
 from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.quantize import side_counts
 from quadcnn_wb.core.pipeline import mesh_domain
@@ -53,9 +52,8 @@ def test_only_the_singular_points_are_irregular(name):
     result = meshed(name)
     # ... and the corners a small concave fillet is read as (input.features): three quads
     # where the boundary is smooth, irregular by DESIGN.md's definition (the thin wall).
-    # (The layout's domain: a small round hole's square has four such corners.)
-    fillets = sum(f.angle is not None
-                  for f in boundary_features(result.reference.domain, result.size))
+    # (A small round hole's square has four such corners.)
+    fillets = result.feature_corners
     assert result.quality["irregular_vertices"] == \
         len(result.reference.field.singularities) + fillets
     mesh = result.mesh

@@ -69,18 +69,9 @@ def run_member(name: str, seed: int, index: int, poses: bool = False) -> dict:
             "share": result.structured_share, "problem": result.problem,
             "min_sj": result.quality["min_scaled_jacobian"],
             "extra_irregular": result.quality["irregular_vertices"]
-            - len(result.reference.field.singularities) - _feature_corners(result),
+            - len(result.reference.field.singularities) - result.feature_corners,
             "same_in_poses": same_in_every_pose(family(name).build(params), result)
             if poses else None}
-
-
-def _feature_corners(result) -> int:
-    """Corners the layout reads where the boundary is smooth (a small concave fillet, a
-    small round hole's square: input.features), irregular by DESIGN.md's count."""
-    from ..core.input.features import boundary_features
-
-    return sum(f.angle is not None
-               for f in boundary_features(result.reference.domain, result.size))
 
 
 def _packed(args):

@@ -16,6 +16,7 @@ import numpy as np
 from .field.pairs import without_cancelling_pairs
 from .field.reference import Reference, background_and_field
 from .input.domain import Domain
+from .input.features import boundary_features
 from .input.pose import default_size
 from .input.small_holes import squared_holes
 from .layout.cuts import connecting_cuts
@@ -51,6 +52,14 @@ class MeshResult:
     def structured_share(self) -> float:
         """Share of the quads that lie in blocks: 1.0 for a fully block-structured mesh."""
         return structured_share(self.mesh)
+
+    @property
+    def feature_corners(self) -> int:
+        """Corners the layout reads where the boundary is smooth (small concave fillets,
+        small round holes' squares: input.features), each a node DESIGN.md counts as
+        irregular beside the field's singular points."""
+        return sum(f.angle is not None
+                   for f in boundary_features(self.reference.domain, self.size))
 
     @property
     def streamlines(self) -> list:

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .corners import interior_angle, is_corner, nearest_quarters
-from .small_holes import SMALL_HOLE, is_quartered
+from .small_holes import is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
@@ -98,8 +98,8 @@ def boundary_features(domain, size: float) -> list:
     out = []
     reach = FEATURE * size
     for li, loop in enumerate(domain.loops):
-        if is_quartered(loop) and 2.0 * loop[0].radius < SMALL_HOLE * size:
-            out.extend(_square_corners(li, loop))  # a small round hole (small_holes.py)
+        if is_quartered(loop):  # a small round hole, squared (small_holes.py decides)
+            out.extend(_square_corners(li, loop))
             continue
         if len(loop) < 2:
             continue  # a lone circle: no corner to read

@@ -31,7 +31,8 @@ CANCELLED = 1e-6  # a weighted mean direction this short (of the weights) is non
 
 
 def is_quartered(loop) -> bool:
-    """Whether a loop is the four quarter arcs of one circle that squared_holes made."""
+    """Whether a loop is the four quarter arcs of one circle that squared_holes made (input
+    healing merges the arcs of one circle, so no input loop is one)."""
     if len(loop) != 4 or not all(isinstance(c, Arc) for c in loop):
         return False
     first = loop[0]
