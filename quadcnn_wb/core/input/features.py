@@ -26,7 +26,16 @@ turns:
   already gets its singular point or its corner from the field).
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
 a chain longer than MAX_SPAN sizes (a curve stored as a polyline), so a part with no such
-features is read exactly as before.  The field (background.py), its corner streamlines
+features is read exactly as before.
+
+A joint that turns by less than SMOOTH_TURN is a smooth join wherever it is: a circle
+or fillet stored as a polyline (a DXF or mesh-derived export, 2° a joint) would otherwise
+make every one of its vertices a vertex of the partition, a place a mesh node must sit,
+and a hundred vertices 0.3 sizes apart along a hole's rim leave no segment counts that
+make opposite block sides equal (pulley_protection's face had a quarter of its quads in
+blocks).  Such a joint is flat, as a step's are, unless it is a concave feature's corner
+(a fillet stored as a polyline still gets its corner).  The mesh then cuts the joint by
+under an element times sin(SMOOTH_TURN / 2) / 2.  The field (background.py), its corner streamlines
 and the partition's vertices read the boundary through these features, so they agree on
 where the corners are.  The quality measure does not: DESIGN.md counts a boundary node as
 irregular by its own interior angle, so a small fillet's corner node, with three quads
@@ -49,6 +58,10 @@ ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a 
 ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle stays a curve)
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
+# A joint turning less is a smooth join.  Not a round number of degrees: a regular polygon
+# of 24, 30 or 36 sides turns by 15°, 12° or 10°, and which side of the rule such a
+# polyline falls on must not hang on round-off.
+SMOOTH_TURN = math.radians(12.5)
 
 
 @dataclass(frozen=True)
@@ -96,37 +109,63 @@ def boundary_features(domain, size: float) -> list:
     rule that reads a loop the same both ways round (a mirrored copy runs the other way);
     a chain longer than MAX_SPAN sizes (a curve stored as a polyline) is read as it is."""
     out = []
-    reach = FEATURE * size
     for li, loop in enumerate(domain.loops):
         if is_quartered(loop):  # a small round hole, squared (small_holes.py decides)
             out.extend(_square_corners(li, loop))
             continue
         if len(loop) < 2:
             continue  # a lone circle: no corner to read
-        total = float(loop_offsets(loop)[-1])
-        turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
-                 or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)]
-        if not turns:
+        features = _loop_features(li, loop, size)
+        out.extend(features + _smooth_joints(li, loop, features))
+    return out
+
+
+def _smooth_joints(li, loop, features) -> list:
+    """A flat feature at each joint turning less than SMOOTH_TURN that no feature holds
+    already (as a member, or as its corner)."""
+    held = {si for f in features for si in f.joints}
+    held |= {f.pivot_segment for f in features if f.pivot_param == 0.0}
+    offsets = loop_offsets(loop)
+    out = []
+    for si, curve in enumerate(loop):
+        angle = interior_angle(loop[si - 1], curve)
+        if si in held or not is_corner(angle) or abs(math.pi - angle) >= SMOOTH_TURN:
             continue
-        gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
-        # A fillet an element long or more is a feature on its own: the corner beside it
-        # is one of the part's, not a detail of the fillet.
-        long = [t[5] - t[4] >= size for t in turns]
-        gaps = [reach if long[k] or long[(k + 1) % len(turns)] else gap
-                for k, gap in enumerate(gaps)]
-        if len(turns) > 1 and max(gaps) < reach:
-            continue  # the whole loop is one chain: read as it is
-        first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
-        chains, chain = [], []
-        for k in range(first, first + len(turns)):
-            chain.append(turns[k % len(turns)])
-            if gaps[k % len(turns)] >= reach:
-                chains.append(chain)
-                chain = []
-        for chain in chains:
-            feature = _feature(li, loop, chain, total, size)
-            if feature is not None:
-                out.append(feature)
+        at = float(offsets[si])
+        out.append(Feature(li, (si,), at, at, at, si, 0.0, None,
+                           np.asarray(loop[si - 1].tangent(1.0), float),
+                           np.asarray(curve.tangent(0.0), float)))
+    return out
+
+
+def _loop_features(li, loop, size) -> list:
+    """One loop's features (see boundary_features), smooth joints aside."""
+    out = []
+    reach = FEATURE * size
+    total = float(loop_offsets(loop)[-1])
+    turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
+             or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)]
+    if not turns:
+        return out
+    gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
+    # A fillet an element long or more is a feature on its own: the corner beside it
+    # is one of the part's, not a detail of the fillet.
+    long = [t[5] - t[4] >= size for t in turns]
+    gaps = [reach if long[k] or long[(k + 1) % len(turns)] else gap
+            for k, gap in enumerate(gaps)]
+    if len(turns) > 1 and max(gaps) < reach:
+        return out  # the whole loop is one chain: read as it is
+    first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
+    chains, chain = [], []
+    for k in range(first, first + len(turns)):
+        chain.append(turns[k % len(turns)])
+        if gaps[k % len(turns)] >= reach:
+            chains.append(chain)
+            chain = []
+    for chain in chains:
+        feature = _feature(li, loop, chain, total, size)
+        if feature is not None:
+            out.append(feature)
     return out
 
 
