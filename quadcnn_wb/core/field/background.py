@@ -319,8 +319,10 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
                               feature.tangent_in)
         into = (s - feature.start) % total  # arc length into the stretch
         pivot = (pivot_s - feature.start) % total
-        inside = into < feature.end - feature.start
         tol = JOINT_TOL * total
+        inside = into < feature.end - feature.start
+        if feature.end == feature.start:  # a smooth joint: its node alone (either side of
+            inside = np.minimum(into, total - into) <= tol  # the joint, as round-off has it)
         before = inside & (into < pivot - tol)
         after = inside & (into > pivot + tol)
         tangents[on_loop[before]] = feature.tangent_in
