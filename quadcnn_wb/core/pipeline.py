@@ -128,18 +128,19 @@ def _best_layout(domain, size, nodes, method, smoothing, learned_streamlines, se
     # than the finer try) unless the finer one leaves more than 1 - GOOD_ENOUGH of its
     # quads out of blocks (nist_ctc04_plate at its default size: 3 s more for 0.905
     # against the finer layout's 0.975).
+    traced = None
     try:
         result = _mesh_on_background(domain, size, nodes, method, smoothing,
                                      learned_streamlines, stop_at_free=True)
         spent = result.timings["total"]
     except LeavesFreeFaces as exc:
-        result, spent = None, exc.seconds
+        result, spent, traced = None, exc.seconds, exc.traced
     if result is not None and result.structured_share >= 1.0:
         return result
     if seconds is not None and (1.0 + FINER_COST) * spent > seconds:
         # No time for it: a mesh now beats a better one past the limit.
         return result or _mesh_on_background(domain, size, nodes, method, smoothing,
-                                             learned_streamlines)
+                                             learned_streamlines, traced=traced)
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
     fair, share = _mesh_key(finer.mesh)[:2]
@@ -147,10 +148,11 @@ def _best_layout(domain, size, nodes, method, smoothing, learned_streamlines, se
         finer.timings["other_background"] = spent
         finer.timings["total"] += spent
         return finer
-    if result is None:
+    if result is None:  # the first layout finished from its streamlines
         result = _mesh_on_background(domain, size, nodes, method, smoothing,
-                                     learned_streamlines)
-        result.timings["total"] += spent
+                                     learned_streamlines, traced=traced)
+        traced_seconds = sum(traced[3].values())
+        result.timings["total"] += spent - traced_seconds
     best, other = (finer, result) if _better(finer, result) else (result, finer)
     best.timings["other_background"] = other.timings["total"]
     best.timings["total"] += other.timings["total"]
@@ -178,36 +180,49 @@ def _mesh_key(mesh) -> tuple:
 class LeavesFreeFaces(Exception):
     """The first layout leaves free faces (``stop_at_free``): not worth finishing yet."""
 
-    def __init__(self, seconds: float):
+    def __init__(self, seconds: float, traced=None):
         super().__init__("the layout leaves free faces")
         self.seconds = seconds
+        self.traced = traced  # (background, field, lines, timings): what finishing reuses
 
 
 def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines,
-                        stop_at_free=False):
+                        stop_at_free=False, traced=None):
     """mesh_domain on a background of ``nodes`` nodes; LeavesFreeFaces, with the seconds
-    spent, if ``stop_at_free`` and the first partition has faces that are no blocks."""
-    timings = {}
-    # The cnn path needs the node count its network was trained for; tracing does not.
-    background, field = background_and_field(domain, nodes, timings,
-                                             strict=method == "cnn", feature_size=size)
-    # Pairs of singular points that cancel are no structure (field.pairs): the layout
-    # (and the result's singular points) is made from the others.
-    field = without_cancelling_pairs(field, background.element_size)
-    clock = time.perf_counter()
-    if method == "cnn":
-        lines, _ = learned_streamlines(domain, background, field)
-        timings["reconstruction"] = time.perf_counter() - clock
+    spent and what was traced, if ``stop_at_free`` and the first partition has faces that
+    are no blocks.  ``traced``: such an exception's, to finish that layout without
+    building its background, field and streamlines again."""
+    if traced is None:
+        timings = {}
+        # The cnn path needs the node count its network was trained for; tracing does not.
+        background, field = background_and_field(domain, nodes, timings,
+                                                 strict=method == "cnn", feature_size=size)
+        # Pairs of singular points that cancel are no structure (field.pairs): the layout
+        # (and the result's singular points) is made from the others.
+        field = without_cancelling_pairs(field, background.element_size)
+        clock = time.perf_counter()
+        if method == "cnn":
+            lines, _ = learned_streamlines(domain, background, field)
+            timings["reconstruction"] = time.perf_counter() - clock
+        else:
+            lines = trace_streamlines(domain, background, field)
+            timings["tracing"] = time.perf_counter() - clock
+        lines = _t_mesh(domain, background, lines)
     else:
-        lines = trace_streamlines(domain, background, field)
-        timings["tracing"] = time.perf_counter() - clock
-    lines = _t_mesh(domain, background, lines)
+        background, field, lines, timings = traced
+        timings = dict(timings)
     problem = ""
     try:
         try:
-            cuts, partition, counts, mesh = blocks_and_mesh(
-                domain, background, field, lines, size, smoothing, timings,
-                allow_free=method != "cnn", stop_at_free=stop_at_free)
+            try:
+                cuts, partition, counts, mesh = blocks_and_mesh(
+                    domain, background, field, lines, size, smoothing, timings,
+                    allow_free=method != "cnn", stop_at_free=stop_at_free)
+            except LeavesFreeFaces as exc:
+                exc.traced = (background, field, lines,
+                              {k: timings[k] for k in ("background", "field", "tracing")
+                               if k in timings})
+                raise
         except PartitionError:
             if method != "cnn":
                 raise

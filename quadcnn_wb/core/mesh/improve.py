@@ -9,7 +9,10 @@ partition vertex slide along their exact curve, between their boundary neighbour
 within the curve stretch they lie on (never past a corner or a step): the boundary stays
 the exact boundary.  Only for quads below SLIDE_BELOW: elsewhere the even spacing along
 the boundary is worth more than a few hundredths of scaled Jacobian (a stress analysis
-reads its peak from the nodes on a hole's rim; uneven ones put it 5 % off).
+reads its peak from the nodes on a hole's rim; uneven ones put it 5 % off).  A strip one
+element thick bent round a fillet is the case that needs it most: equal arc length on
+the inner and the outer curve shears every quad past the bend (a bent sheet-metal
+profile's worst quad 0.50 at 0.5, 0.70 at 0.65).
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ import numpy as np
 NEXT_CORNER = np.array([1, 2, 3, 0])
 PREVIOUS_CORNER = np.array([3, 0, 1, 2])
 SLIDE_FRACTIONS = (0.3, 0.1, 0.03)
-SLIDE_BELOW = 0.5  # a boundary node slides only for a quad worse than this
+SLIDE_BELOW = 0.65  # a boundary node slides only for a quad worse than this
 
 
 @dataclass
