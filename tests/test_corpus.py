@@ -198,19 +198,21 @@ def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_so
     # The freeing rounds and unstructured fills of a layout that leaves free faces cost
     # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
     # it: sketch_slot_plate's finer layout is all blocks, nist_ctc04_plate's 97.5 % of
-    # it (GOOD_ENOUGH), crank_arm_web's 37 %.
+    # it (GOOD_ENOUGH), crank_arm_web's 94 %.
     from quadcnn_wb.core import pipeline
 
-    calls = []
+    calls, reused = [], []
     real = pipeline._mesh_on_background
 
-    def counted(domain, size, nodes, *args, stop_at_free=False):
+    def counted(domain, size, nodes, *args, stop_at_free=False, traced=None):
         try:
-            result = real(domain, size, nodes, *args, stop_at_free=stop_at_free)
+            result = real(domain, size, nodes, *args, stop_at_free=stop_at_free,
+                          traced=traced)
         except pipeline.LeavesFreeFaces:
             calls.append(("stopped", nodes))
             raise
         calls.append(("finished", nodes))
+        reused.append(traced is not None)
         return result
 
     monkeypatch.setattr(pipeline, "_mesh_on_background", counted)
@@ -218,6 +220,8 @@ def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_so
     assert calls[0] == ("stopped", 2048)
     assert [n for what, n in calls[1:] if what == "finished"] == finished
     assert len(calls) == 1 + len(finished)
+    # The stopped layout is finished from the streamlines it traced, the finer one fresh.
+    assert reused == [n == 2048 for n in finished]
     assert result.timings["other_background"] > 0
 
 
