@@ -155,3 +155,48 @@ def test_a_zero_outside_its_triangle_goes_to_the_nearest_point_whatever_the_corn
         inside = corners[0] + np.outer(u, corners[1] - corners[0]) \
             + np.outer(v, corners[2] - corners[0])
         assert np.hypot(*(p - places[0])) <= np.hypot(*(inside - p).T).min() + 1e-12
+
+
+def twin_bore(d, r=1.5):
+    """A hole made of two overlapping disks of radius r, centres 2d apart: a loop of two
+    arcs meeting at two sharp corners (26.5° at d = 1.46, 37.6° at d = 1.42), as where
+    two bores of a pulley guard plate overlap."""
+    h = math.sqrt(r * r - d * d)
+    top, bottom = [0.0, h], [0.0, -h]
+    return [{"arc": [top, [d + r, 0.0], bottom]}, {"arc": [bottom, [-d - r, 0.0], top]}]
+
+
+@pytest.mark.parametrize("d", [1.42, 1.46])
+def test_sharp_corners_between_two_bores_are_one_quad_corners(d):
+    """The cross turns the long way round a lone corner of 22.5-45° (one quad's worth):
+    read the short way, as a cusp, each corner had a valence-3 point beside it, with a
+    valence-5 to answer it, and free faces between (share 0.96, 18 irregular vertices,
+    worst scaled Jacobian 0.26-0.35)."""
+    from shapes import rect
+
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    loops = [rect(10, 6, -5, -3), twin_bore(d)]
+    result = mesh_domain(domain_from_json({"loops": loops}))
+    q = result.quality
+    assert result.structured_share == 1.0, result.problem
+    assert sorted(s.valence for s in result.reference.field.singularities) == [5] * 6
+    assert q["irregular_vertices"] == 6 and q["min_scaled_jacobian"] > 0.6
+    moved = mesh_domain(domain_from_json(transform_domain(
+        {"loops": loops}, rotation(211, 1e3, mirror=True), shift=(1e4, 3.0)))).quality
+    assert (moved["quads"], moved["irregular_vertices"]) == (q["quads"], 6)
+
+
+def test_a_sharp_corner_the_field_cannot_turn_the_long_way_stays_a_cusp():
+    """A 40° corner of a trapezoid with a hole: the long way round leaves a zero in the
+    corner's own triangle that nothing answers, so the corner is read as a cusp (short
+    way; only the hole's four valence-5 points)."""
+    from shapes import circle, polygon
+
+    from quadcnn_wb.core.input.pose import canonical_pose
+
+    tip = 3 / math.tan(math.radians(40))
+    domain = domain_from_json({"loops": [polygon([[0, 0], [8, 0], [8, 3], [tip, 3]]),
+                                         circle(6, 1.5, 0.8)]})
+    field = compute_frame_field(background_mesh(domain, 2048), canonical_pose(domain))
+    assert sorted(s.valence for s in field.singularities) == [5, 5, 5, 5]

@@ -83,7 +83,11 @@ def cotangent_laplacian(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matr
                          shape=(n, n))
 
 
-def boundary_values(mesh: BackgroundMesh) -> np.ndarray:
+SHARP_LOW = math.radians(22.5)
+PARTNER = 3.0  # background elements: a zero at a sharp corner answered this close stays
+
+
+def boundary_values(mesh: BackgroundMesh, sharp=None) -> np.ndarray:
     """z on boundary nodes: the tangent's fourth power; a corner splits the difference.
 
     At a corner whose angle is a whole number of quarter turns both edges give the same
@@ -93,10 +97,20 @@ def boundary_values(mesh: BackgroundMesh) -> np.ndarray:
     the two edges' z, except where that sum is zero.  There (a 135° chamfer, a 225° notch)
     the sum decided nothing, and whichever way round-off then made the field wind seeded
     a singular point at the corner; now it winds the way its quarter turns say.
+
+    A lone corner of SHARP_LOW..45° (sharp: see _sharp_corners) rounds to no quarter turn,
+    a cusp, and the sum would turn the cross the short way; but the mesh puts one quad
+    there, whose turn is the long way round, and read as a cusp such a corner needs a
+    valence-3 point beside it (where two bores overlap: a point at each cusp, its
+    valence-5 partner, and free faces between).  So the corner node holds the long way
+    (minus the sum), unless the field takes it back (_undone_sharp_corners).  Below
+    SHARP_LOW (tangent arcs, gear roots) the short way is kept: one quad of under 22.5°
+    is worse than the valence-3 point.
     """
     t = mesh.boundary_tangent[:, 0] + 1j * mesh.boundary_tangent[:, 1]
     z = t**4
     position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
+    sharp = _sharp_corners(mesh) if sharp is None else sharp
     for node, t_in, angle in zip(mesh.corner_nodes, mesh.corner_tangents_in,
                                  mesh.corner_angles):
         k = position[int(node)]
@@ -107,7 +121,25 @@ def boundary_values(mesh: BackgroundMesh) -> np.ndarray:
         else:
             blend = t_in**4 + z[k]
             z[k] = blend / abs(blend)
+            if node in sharp:  # one quad's worth of turn: the long way round
+                z[k] = -z[k]
     return z
+
+
+def _sharp_corners(mesh: BackgroundMesh) -> set:
+    """Corner nodes of SHARP_LOW..45° that stand alone (no other corner within a
+    background element): the cross there turns the long way, as at one quad's corner."""
+    nodes = np.asarray(mesh.corner_nodes, dtype=np.int64)
+    out = set()
+    for k, (node, angle) in enumerate(zip(nodes, mesh.corner_angles)):
+        if not SHARP_LOW < angle < math.pi / 4:
+            continue
+        others = np.delete(nodes, k)
+        gap = np.hypot(*(mesh.nodes[others] - mesh.nodes[node]).T).min() if len(others) \
+            else np.inf
+        if gap >= mesh.element_size:
+            out.add(int(node))
+    return out
 
 
 def solve_cross_field(mesh: BackgroundMesh, boundary_z: np.ndarray | None = None) -> np.ndarray:
@@ -158,7 +190,8 @@ def compute_frame_field(mesh: BackgroundMesh, pose=None) -> FrameField:
         corner_tangents_in=np.round(mesh.corner_tangents_in @ a.T, POSE_DIGITS) + 0.0,
         # a mirror turns the triangles clockwise: back to counter-clockwise, so windings
         # (and valences) keep their sign
-        triangles=mesh.triangles[:, ::-1] if pose.mirrored else mesh.triangles)
+        triangles=mesh.triangles[:, ::-1] if pose.mirrored else mesh.triangles,
+        element_size=round(mesh.element_size / pose.scale, POSE_DIGITS))
     z_unit, singular = _zeros(posed)
     turn = complex(a[0, 0], a[1, 0]) if not pose.mirrored else complex(-a[0, 0], a[1, 0])
     z = (np.conj(z_unit) if pose.mirrored else z_unit) * np.conj(turn) ** 4
@@ -176,12 +209,36 @@ def _field_here(mesh: BackgroundMesh) -> FrameField:
 
 def _zeros(mesh: BackgroundMesh) -> tuple:
     """(z, singular points) on this mesh, in its own coordinates."""
-    z = solve_cross_field(mesh)
+    sharp = _sharp_corners(mesh)
+    z = solve_cross_field(mesh, boundary_values(mesh, sharp))
     windings = triangle_windings(z, mesh.triangles)
     singular = np.nonzero(windings)[0]
+    undone = _undone_sharp_corners(mesh, sharp, windings, singular)
+    if undone:
+        z = solve_cross_field(mesh, boundary_values(mesh, sharp - undone))
+        windings = triangle_windings(z, mesh.triangles)
+        singular = np.nonzero(windings)[0]
     patches = _triangle_patches(mesh.triangles, singular)
     return z, tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
                     for t, patch in zip(singular, patches))
+
+
+def _undone_sharp_corners(mesh, sharp, windings, singular) -> set:
+    """Sharp corners whose long way round the field takes back at once: a zero in a
+    triangle at the corner with no zero of the other sign within PARTNER elements to
+    answer it.  There the corner is a cusp after all (the short way, no zero)."""
+    if not sharp or not len(singular):
+        return set()
+    centres = mesh.nodes[mesh.triangles[singular]].mean(axis=1)
+    signs = windings[singular]
+    undone = set()
+    for n in sorted(sharp):
+        for k in np.nonzero(np.isin(mesh.triangles[singular], n).any(axis=1))[0]:
+            other = signs == -signs[k]
+            near = np.hypot(*(centres[other] - centres[k]).T) < PARTNER * mesh.element_size
+            if not near.any():
+                undone.add(n)
+    return undone
 
 
 def _triangle_patches(triangles: np.ndarray, chosen: np.ndarray) -> list:
