@@ -25,8 +25,8 @@ turns:
 - a convex feature stays as its curves and corners are (a small convex fillet or chamfer
   already gets its singular point or its corner from the field).
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
-a chain longer than MAX_SPAN sizes (a curve stored as a polyline), so a part with no such
-features is read exactly as before.
+a chain longer than MAX_SPAN sizes (a curve stored as a polyline: see below), so a part
+with no such features is read exactly as before.
 
 A joint that turns by less than SMOOTH_TURN is a smooth join wherever it is: a circle
 or fillet stored as a polyline (a DXF or mesh-derived export, 2° a joint) would otherwise
@@ -35,12 +35,13 @@ and a hundred vertices 0.3 sizes apart along a hole's rim leave no segment count
 make opposite block sides equal (pulley_protection's face had a quarter of its quads in
 blocks).  Such a joint is flat, as a step's are, unless it is a concave feature's corner
 (a fillet stored as a polyline still gets its corner).  The mesh then cuts the joint by
-under an element times sin(SMOOTH_TURN / 2) / 2.  The field (background.py), its corner streamlines
-and the partition's vertices read the boundary through these features, so they agree on
-where the corners are.  The quality measure does not: DESIGN.md counts a boundary node as
-irregular by its own interior angle, so a small fillet's corner node, with three quads
-where the boundary is smooth, is one irregular vertex (as the valence-5 point a fillet
-read as a curve needs would be).
+under an element times sin(SMOOTH_TURN / 2) / 2.
+
+The field (background.py), its corner streamlines and the partition's vertices read the
+boundary through these features, so they agree on where the corners are.  The quality
+measure does not: DESIGN.md counts a boundary node as irregular by its own interior
+angle, so a small fillet's corner node, with three quads where the boundary is smooth,
+is one irregular vertex (as the valence-5 point a fillet read as a curve needs would be).
 """
 
 from __future__ import annotations
@@ -107,7 +108,8 @@ def boundary_features(domain, size: float) -> list:
 
     Turns chain into one feature while each is less than FEATURE sizes from the next, a
     rule that reads a loop the same both ways round (a mirrored copy runs the other way);
-    a chain longer than MAX_SPAN sizes (a curve stored as a polyline) is read as it is."""
+    a chain longer than MAX_SPAN sizes (a curve stored as a polyline) is no feature, but
+    its joints under SMOOTH_TURN are smooth joins (_smooth_joints)."""
     out = []
     for li, loop in enumerate(domain.loops):
         if is_quartered(loop):  # a small round hole, squared (small_holes.py decides)
