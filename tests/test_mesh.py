@@ -309,3 +309,31 @@ def test_of_two_layouts_a_near_flat_quad_outweighs_a_higher_structured_share():
     assert _mesh_key(all_blocks_sliver)[2] < FAIR_JACOBIAN < _mesh_key(half_blocks_fair)[2]
     assert _mesh_key(half_blocks_fair) > _mesh_key(all_blocks_sliver)
     assert _mesh_key(all_blocks_fine) > _mesh_key(half_blocks_fair)
+
+
+def test_boundary_nodes_slide_across_smooth_joints_but_not_past_corners():
+    """A boundary edge's stretches (quadmesh._EdgeChain) run over the joints that turn
+    under SMOOTH_TURN (a polyline's, a tangent arc's), so its nodes can slide from one
+    curve to the next there; a real corner inside the edge (a step's) bounds them."""
+    import math
+
+    from shapes import polygon
+
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.partition_types import BoundaryPiece, Edge
+    from quadcnn_wb.core.mesh.quadmesh import _EdgeChain
+
+    # A plate with a half-disc notch in its top edge, the notch a 30-line polyline.
+    arc = [[2 + math.cos(a), 2 - math.sin(a)] for a in np.linspace(0, math.pi, 31)]
+    domain = domain_from_json({"loops": [polygon([[0, 0], [4, 0], [4, 2]] + arc + [[0, 2]])]})
+    loop = domain.loops[0]
+    assert len(loop) == 35
+    # An edge along the top: [4,2]->[3,2], the notch, [1,2]->[0,2]; a corner at each end
+    # of the notch, 30 smooth joints inside it.
+    pieces = tuple(BoundaryPiece(0, si, 0.0, 1.0) for si in range(2, 34))
+    chain = _EdgeChain(domain, Edge(points=np.zeros((2, 2)), a=0, b=1, pieces=pieces))
+    assert chain.stretch_of == [0] + [1] * 30 + [2]
+    lo, hi = chain.stretch_bounds(1)
+    assert hi - lo == pytest.approx(sum(c.length for c in loop[3:33]))
+    middle = chain.point(0.5 * (lo + hi))
+    assert np.hypot(*(middle - [2, 2])) == pytest.approx(1.0, abs=0.01)  # on the arc

@@ -13,10 +13,13 @@ value and SMOOTH_FLOOR; then the worst quads get max-min moves (improve.py).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..input.corners import interior_angle
+from ..input.features import SMOOTH_TURN
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
@@ -60,24 +63,63 @@ def _boundary_edge_points(domain, edge, n: int) -> tuple:
 
 
 def _slides(domain, partition, layout, ids, where) -> dict:
-    """The boundary nodes that may slide along their curve (see improve.py): every inner
-    node of a boundary edge, bounded by its neighbours on the same curve stretch."""
+    """The boundary nodes that may slide along the boundary (see improve.py): every inner
+    node of a boundary edge, bounded by its neighbours on the same stretch.  A stretch
+    runs over the curves the edge passes through where they join smoothly (a tangent
+    joint, or one turning under SMOOTH_TURN): a one-element strip bent round a fillet
+    needs its nodes to cross from the fillet to the line beside it, and the node count on
+    the inner and the outer fillet rarely matches."""
     slides = {}
     for e, (edge, spots) in enumerate(zip(partition.edges, where)):
         if spots is None:
             continue
         nodes = ids[layout.edge_nodes[e]]
+        chain = _EdgeChain(domain, edge)
+        along = [chain.arc_length(i, t) for i, t in spots]
+        stretch = [chain.stretch_of[i] for i, _ in spots]
         for k in range(1, len(spots) - 1):
-            i, t = spots[k]
-            piece = edge.pieces[i]
-            same_before, same_after = spots[k - 1][0] == i, spots[k + 1][0] == i
+            lo, hi = chain.stretch_bounds(stretch[k])
+            same_before = stretch[k - 1] == stretch[k]
+            same_after = stretch[k + 1] == stretch[k]
             slides[int(nodes[k])] = BoundarySlide(
-                curve=domain.loops[piece.loop][piece.segment], t=t,
+                curve=chain, t=along[k],
                 before=int(nodes[k - 1]) if same_before and k > 1 else None,
                 after=int(nodes[k + 1]) if same_after and k < len(spots) - 2 else None,
-                t_before=spots[k - 1][1] if same_before else piece.t0,
-                t_after=spots[k + 1][1] if same_after else piece.t1)
+                t_before=along[k - 1] if same_before else lo,
+                t_after=along[k + 1] if same_after else hi)
     return slides
+
+
+class _EdgeChain:
+    """A boundary edge's exact curve stretches as one curve of its arc length, split
+    into stretches at the joints that are no smooth joins."""
+
+    def __init__(self, domain, edge):
+        self.curves = [domain.loops[p.loop][p.segment] for p in edge.pieces]
+        self.pieces = edge.pieces
+        lengths = [c.length * abs(p.t1 - p.t0) for c, p in zip(self.curves, self.pieces)]
+        self.start = np.concatenate([[0.0], np.cumsum(lengths)])
+        self.stretch_of = [0]
+        for i in range(1, len(self.curves)):
+            turn = abs(math.pi - interior_angle(self.curves[i - 1], self.curves[i]))
+            self.stretch_of.append(self.stretch_of[-1] + (turn >= SMOOTH_TURN))
+
+    def arc_length(self, i: int, t: float) -> float:
+        p = self.pieces[i]
+        span = p.t1 - p.t0
+        f = (t - p.t0) / span if span else 0.0
+        return float(self.start[i] + f * (self.start[i + 1] - self.start[i]))
+
+    def stretch_bounds(self, stretch: int) -> tuple:
+        mine = [i for i, k in enumerate(self.stretch_of) if k == stretch]
+        return float(self.start[mine[0]]), float(self.start[mine[-1] + 1])
+
+    def point(self, s: float) -> np.ndarray:
+        i = int(np.clip(np.searchsorted(self.start, s, side="right") - 1, 0,
+                        len(self.curves) - 1))
+        p, length = self.pieces[i], self.start[i + 1] - self.start[i]
+        f = min(max((s - self.start[i]) / length, 0.0), 1.0) if length > 0 else 0.0
+        return self.curves[i].point(float(p.t0 + f * (p.t1 - p.t0)))
 
 
 def _polyline_points(points: np.ndarray, n: int) -> np.ndarray:
