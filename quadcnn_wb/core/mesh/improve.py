@@ -7,8 +7,9 @@ arc length leave skewed quads that no move of interior nodes mends.  So the wors
 interior nodes try a compass of moves, and their boundary nodes that are not a domain or
 partition vertex slide along their exact curve, between their boundary neighbours and
 within the stretch of smoothly joined curves they lie on (quadmesh._EdgeChain; never past
-a corner or a step): the boundary stays the exact boundary.  Only for quads below SLIDE_BELOW: elsewhere the even spacing along
-the boundary is worth more than a few hundredths of scaled Jacobian (a stress analysis
+a corner or a step): the boundary stays the exact boundary.  Only for quads below
+SLIDE_BELOW: elsewhere the even spacing along the boundary is worth more than a few
+hundredths of scaled Jacobian (a stress analysis
 reads its peak from the nodes on a hole's rim; uneven ones put it 5 % off).  A strip one
 element thick bent round a fillet is the case that needs it most: equal arc length on
 the inner and the outer curve shears every quad past the bend (a bent sheet-metal
