@@ -65,6 +65,12 @@ JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that 
 SMOOTH_TURN = math.radians(12.5)
 
 
+def is_smooth_join(angle: float) -> bool:
+    """Whether a joint of this interior angle turns by less than SMOOTH_TURN (a tangent
+    joint included): the layout reads it as no corner, and slides run over it."""
+    return abs(math.pi - angle) < SMOOTH_TURN
+
+
 @dataclass(frozen=True)
 class Feature:
     """A stretch of one loop read as one joint: a corner (angle) or flat (angle None)."""
@@ -131,7 +137,7 @@ def _smooth_joints(li, loop, features) -> list:
     out = []
     for si, curve in enumerate(loop):
         angle = interior_angle(loop[si - 1], curve)
-        if si in held or not is_corner(angle) or abs(math.pi - angle) >= SMOOTH_TURN:
+        if si in held or not is_corner(angle) or not is_smooth_join(angle):
             continue
         at = float(offsets[si])
         out.append(Feature(li, (si,), at, at, at, si, 0.0, None,

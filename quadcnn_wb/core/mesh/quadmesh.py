@@ -13,13 +13,12 @@ value and SMOOTH_FLOOR; then the worst quads get max-min moves (improve.py).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..input.corners import interior_angle
-from ..input.features import SMOOTH_TURN
+from ..input.features import is_smooth_join
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
@@ -101,8 +100,8 @@ class _EdgeChain:
         self.start = np.concatenate([[0.0], np.cumsum(lengths)])
         self.stretch_of = [0]
         for i in range(1, len(self.curves)):
-            turn = abs(math.pi - interior_angle(self.curves[i - 1], self.curves[i]))
-            self.stretch_of.append(self.stretch_of[-1] + (turn >= SMOOTH_TURN))
+            smooth = is_smooth_join(interior_angle(self.curves[i - 1], self.curves[i]))
+            self.stretch_of.append(self.stretch_of[-1] + (not smooth))
 
     def arc_length(self, i: int, t: float) -> float:
         p = self.pieces[i]
