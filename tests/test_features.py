@@ -32,7 +32,8 @@ def test_steps_are_flat_and_a_small_concave_fillet_is_one_corner():
 
 def test_at_a_size_that_resolves_them_the_boundary_is_read_as_it_is():
     domain = named_domain("thin wall")
-    assert boundary_features(domain, default_size(domain) / 10) == []
+    # (At a tenth of the default size the fillet's radius is ROUND sizes to round-off.)
+    assert boundary_features(domain, default_size(domain) / 12) == []
 
 
 @pytest.mark.parametrize("loops", [[rect(3, 2)], OWN_SHAPES["chamfered plate"][0],
@@ -61,7 +62,7 @@ def test_the_background_has_the_fillet_corner_and_no_step_corners():
     assert angles.count(270.0) == 1
     assert all(a == 90.0 for a in angles if a != 270.0)
     assert len(mesh.flat_joints) == 6  # both steps' corners, the fillet's two ends
-    fine = background_mesh(domain, nodes=1000, feature_size=default_size(domain) / 10)
+    fine = background_mesh(domain, nodes=1000, feature_size=default_size(domain) / 12)
     assert fine.flat_joints == frozenset()
     assert len(fine.corner_angles) == len(domain.loops[0]) - 2  # the fillet's ends are smooth
 
@@ -185,3 +186,77 @@ def test_a_polylines_reading_is_the_same_in_every_pose():
                                               shift=(1e4, 3.0)))
     assert summary(boundary_features(moved, default_size(moved))) == \
         summary(boundary_features(base, default_size(base)))
+
+
+def rounded_rect(w, h, r, hole=None):
+    """A w × h plate whose four corners are 90° fillets of radius r (arcs given by three
+    points, as a sketch stores them), with an optional round hole."""
+    def arc(cx, cy, a0):
+        return {"arc": [[cx + r * math.cos(math.radians(a0 + d)),
+                         cy + r * math.sin(math.radians(a0 + d))] for d in (0, 45, 90)]}
+    loop = [{"line": [[r, 0], [w - r, 0]]}, arc(w - r, r, -90),
+            {"line": [[w, r], [w, h - r]]}, arc(w - r, h - r, 0),
+            {"line": [[w - r, h], [r, h]]}, arc(r, h - r, 90),
+            {"line": [[0, h - r], [0, r]]}, arc(r, r, 180)]
+    return domain_from_json({"loops": [loop] + ([circle(*hole)] if hole else [])})
+
+
+def test_a_small_convex_fillet_is_one_corner_at_its_middle():
+    # A fillet under an element in radius is a corner at the mesh's scale: read as a curve,
+    # the face around it had three corners and was split round an extra vertex.
+    size = default_size(rounded_rect(100, 60, 1.0))
+    plate = rounded_rect(100, 60, 0.7 * size)
+    features = boundary_features(plate, size)
+    assert summary(features) == [(2, 90.0)] * 4  # each fillet's two smooth joints
+    assert all(f.pivot_param == pytest.approx(0.5) for f in features)
+    assert boundary_features(rounded_rect(100, 60, 1.2 * size), size) == []
+
+
+def test_a_rounded_sharp_tip_is_one_corner_and_a_slots_round_end_stays_a_curve():
+    size = 1.0
+    # A 40° spike whose tip is a 0.3 fillet (a lettering's stroke end, a gear's tooth).
+    r, half = 0.3, math.radians(20)
+    apex = np.array([10.0, 0.0])
+    centre = apex - np.array([r / math.sin(half), 0.0])
+    p_low = centre + r * np.array([math.sin(half), -math.cos(half)])
+    p_high = centre + r * np.array([math.sin(half), math.cos(half)])
+    low = (p_low - 10 * np.array([math.cos(half), math.sin(half)])).tolist()
+    high = (p_high - 10 * np.array([math.cos(half), -math.sin(half)])).tolist()
+    spike = [{"line": [low, p_low.tolist()]},
+             {"arc": [p_low.tolist(), (centre + [r, 0]).tolist(), p_high.tolist()]},
+             {"line": [p_high.tolist(), high]}, {"line": [high, low]}]
+    tip = boundary_features(domain_from_json({"loops": [spike]}), size)
+    assert summary(tip) == [(2, 40.0)]
+    # A slot 0.4 wide ends in a half circle: no corner in it.
+    slot = [{"line": [[0, 0], [10, 0]]}, {"arc": [[10, 0], [10.2, 0.2], [10, 0.4]]},
+            {"line": [[10, 0.4], [0, 0.4]]}, {"line": [[0, 0.4], [0, 0]]}]
+    assert boundary_features(domain_from_json({"loops": [slot]}), size) == []
+
+
+def test_a_lone_concave_fillet_longer_than_max_span_is_still_one_corner():
+    # ROUND sizes of radius allow a quarter arc longer than MAX_SPAN sizes, the limit
+    # meant for chains of turns (a polyline), not for one curve.
+    size = 1.0
+    r = 2.2
+    mid = [5 + r - r * math.cos(math.radians(45)), 5 + r - r * math.sin(math.radians(45))]
+    loops = [[{"line": [[0, 0], [20, 0]]}, {"line": [[20, 0], [20, 5]]},
+              {"line": [[20, 5], [5 + r, 5]]}, {"arc": [[5 + r, 5], mid, [5, 5 + r]]},
+              {"line": [[5, 5 + r], [5, 20]]}, {"line": [[5, 20], [0, 20]]},
+              {"line": [[0, 20], [0, 0]]}]]
+    features = boundary_features(domain_from_json({"loops": loops}), size)
+    assert summary(features) == [(2, 270.0)]
+
+
+def test_a_plate_with_small_convex_fillets_gets_the_sharp_plates_blocks():
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    sharp = domain_from_json({"loops": [rect(100, 60), circle(30, 30, 10)]})
+    size = default_size(sharp)
+    rounded = rounded_rect(100, 60, 0.7 * size, hole=(30, 30, 10))
+    want, got = mesh_domain(sharp, size=size), mesh_domain(rounded, size=size)
+    assert got.structured_share == 1.0
+    assert got.quality["blocks"] == want.quality["blocks"]
+    # Each fillet's middle node has the one quad of a corner, where DESIGN.md's count
+    # expects two on a smooth curve: the hole's four valence-5 points and those four.
+    assert got.quality["irregular_vertices"] == want.quality["irregular_vertices"] + 4
+    assert got.quality["min_scaled_jacobian"] > 0.85

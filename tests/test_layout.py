@@ -95,3 +95,36 @@ def test_a_split_whose_blocks_cannot_be_filled_is_left_whole_in_the_rebuild():
     assert splits[0] not in {e.origin for e in again.edges}
     assert any("whose split could not be filled" in f.reason for f in again.free_faces)
     assert len(again.blocks) < len(first.blocks)
+
+
+def test_a_separatrix_running_along_the_boundary_leaves_no_sliver_face():
+    # A trace that meets the boundary at a glancing angle and runs on beside it a fraction
+    # of an element off (nist_ctc_05's lettering) cut a face no quad fits in; it is the
+    # boundary's own line there, so the partition drops it and keeps the blocks.
+    import numpy as np
+
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.partition import build_partition
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    loop = [{"line": [[0, 0], [10, 0]]}, {"line": [[10, 0], [10, 4]]},
+            {"line": [[10, 4], [0, 4]]}, {"line": [[0, 4], [0, 0]]}]
+    domain = domain_from_json({"loops": [loop]})
+
+    def line(points, start, end):
+        return Streamline(np.array(points, float), Endpoint("boundary", loop=0, **start),
+                          Endpoint("boundary", loop=0, **end))
+
+    across = line([[5, 0], [5, 4]], dict(segment=0, param=0.5), dict(segment=2, param=0.5))
+    glancing = line([[6, 0], [8, 0.03], [10, 0.05]], dict(segment=0, param=0.6),
+                    dict(segment=1, param=0.0125))
+    alone = build_partition(domain, [across], 1.0)
+    both = build_partition(domain, [across, glancing], 1.0)
+    assert (len(alone.blocks), len(alone.free_faces)) == (2, 0)
+    assert (len(both.blocks), len(both.free_faces)) == (2, 0)
+    assert not any(edge.streamline == 1 for edge in both.edges)
+    # A strip a quarter element wide or more is a face of its own (here: a block).
+    wide = line([[6, 0], [7, 0.4], [10, 0.4]], dict(segment=0, param=0.6),
+                dict(segment=1, param=0.1))
+    kept = build_partition(domain, [across, wide], 1.0)
+    assert any(edge.streamline == 1 for edge in kept.edges)

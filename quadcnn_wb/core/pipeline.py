@@ -296,7 +296,7 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
         partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
-                                    background.flat_joints)
+                                    background.flat_joints, background.feature_corners)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")

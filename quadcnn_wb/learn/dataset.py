@@ -83,7 +83,8 @@ def make_sample(source, seed: int, index: int, nodes: int = 2048):
     if any(line.capped for line in ref.streamlines):
         return None, "a streamline had to be capped"
     try:
-        build_partition(domain, ref.streamlines, mesh.element_size, flat_joints=mesh.flat_joints)
+        build_partition(domain, ref.streamlines, mesh.element_size, flat_joints=mesh.flat_joints,
+                        feature_corners=mesh.feature_corners)
     except PartitionError:
         return None, "partition not four-sided"
     hints = ray_features(mesh.nodes, mesh.triangles, ref.field.theta, field_rays(ref.field),

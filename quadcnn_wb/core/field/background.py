@@ -55,6 +55,9 @@ class BackgroundMesh:
     # (loop, segment) of the loop vertices that are no corner at the mesh's scale: part of
     # a feature below the element size (input.features), read as part of a side.
     flat_joints: frozenset = frozenset()
+    # (loop, segment, parameter, interior angle) of the corners features put inside a
+    # curve (a small fillet's middle): vertices of the partition, as loop vertices are.
+    feature_corners: frozenset = frozenset()
 
     @property
     def n_nodes(self) -> int:
@@ -299,7 +302,7 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
     lengths = [np.array([c.length for c in loop]) for loop in domain.loops]
     along = np.array([offsets[li][si] + t * lengths[li][si] for li, si, t in
                       zip(mesh.boundary_loop, mesh.boundary_segment, mesh.boundary_param)])
-    flat = set()
+    flat, inside_curves = set(), set()
     for feature in features:
         total = float(offsets[feature.loop][-1])
         on_loop = np.nonzero(mesh.boundary_loop == feature.loop)[0]
@@ -317,6 +320,9 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
                 pivot_s = float(along[k])
                 corners[k] = (int(mesh.boundary_nodes[k]), float(feature.angle),
                               feature.tangent_in)
+                if feature.pivot_param > 0.0:
+                    inside_curves.add((feature.loop, feature.pivot_segment,
+                                       float(mesh.boundary_param[k]), float(feature.angle)))
         into = (s - feature.start) % total  # arc length into the stretch
         pivot = (pivot_s - feature.start) % total
         tol = JOINT_TOL * total
@@ -339,7 +345,7 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
         corner_angles=np.array([corners[k][1] for k in order], dtype=float),
         corner_tangents_in=np.array([corners[k][2] for k in order],
                                     dtype=float).reshape(-1, 2),
-        flat_joints=frozenset(flat))
+        flat_joints=frozenset(flat), feature_corners=frozenset(inside_curves))
 
 
 def _counter_clockwise(coords, triangles):

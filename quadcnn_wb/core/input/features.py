@@ -8,10 +8,10 @@ corner is smooth, so no streamline leaves it and the face around it keeps a refl
 corner; a bump's tilted edge bends the cross field into a singular point.
 
 So the boundary is read at the element's scale.  Its turns (each corner, and the whole
-turn of each curve shorter than FEATURE sizes or of a concave fillet of radius under ROUND
-sizes turning at most ROUND_SWEEP) chain while each lies less than FEATURE sizes from the next;
-a chain holding more than one turn, or a curve's, is one feature with the sum of its
-turns:
+turn of each curve shorter than FEATURE sizes, of a concave fillet of radius under ROUND
+sizes turning at most ROUND_SWEEP, or of a convex one of radius under CONVEX_ROUND sizes)
+chain while each lies less than FEATURE sizes from the next; a chain holding more than one
+turn, or a curve's, is one feature with the sum of its turns:
 - a feature whose interior angle rounds to two quarter turns (a step, a bump) is flat:
   part of the side it sits on, with no corner, no corner streamlines and no vertex of the
   partition (the side's mesh nodes run over it);
@@ -22,11 +22,17 @@ turns:
   well when the radius is a few elements or less (motor_c_plate's 1 mm fillets got
   none, the gear's root fillets a cluster); as a corner it needs none, and the quads at
   its middle meet at 45° to the curve plus what the curve turns under one element;
-- a convex feature stays as its curves and corners are (a small convex fillet or chamfer
-  already gets its singular point or its corner from the field).
+- a convex feature of CONVEX_MIN or more (a small fillet on a plate's corner, a stroke's
+  rounded tip) is one convex corner in its middle, likewise.  Read as a curve, the face
+  around it turned by a quarter within one partition edge and had three corners, and
+  was split round an extra vertex (a rounded plate's corners came out as three squeezed
+  quads each, worst scaled Jacobian 0.68 against 0.95 as corners); where a convex fillet
+  is an element or more in radius, the field puts its valence-3 point in it instead;
+- a sharper convex feature (a narrow slot's round end) stays as its curves are.
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
-a chain longer than MAX_SPAN sizes (a curve stored as a polyline: see below), so a part
-with no such features is read exactly as before.
+a chain of turns longer than MAX_SPAN sizes (a curve stored as a polyline: see below; one
+fillet's length is bounded by its radius rule), so a part with no such features is read
+exactly as before.
 
 A joint that turns by less than SMOOTH_TURN is a smooth join wherever it is: a circle
 or fillet stored as a polyline (a DXF or mesh-derived export, 2° a joint) would otherwise
@@ -57,12 +63,14 @@ from .small_holes import is_quartered
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
 ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle stays a curve)
+CONVEX_ROUND = 1.0  # element sizes: so is a convex fillet of a smaller radius
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
 # A joint turning less is a smooth join.  Not a round number of degrees: a regular polygon
 # of 24, 30 or 36 sides turns by 15°, 12° or 10°, and which side of the rule such a
 # polyline falls on must not hang on round-off.
 SMOOTH_TURN = math.radians(12.5)
+CONVEX_MIN = math.radians(22.5)  # a convex feature this sharp or blunter is one corner
 
 
 def is_smooth_join(angle: float) -> bool:
@@ -152,7 +160,8 @@ def _loop_features(li, loop, size) -> list:
     reach = FEATURE * size
     total = float(loop_offsets(loop)[-1])
     turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
-             or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)]
+             or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)
+             or (loop[t[2]].radius < CONVEX_ROUND * size and 0.0 < t[1] <= math.pi - CONVEX_MIN)]
     if not turns:
         return out
     gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
@@ -191,13 +200,13 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     if len(group) == 1 and group[0][3] == "joint":
         return None  # a lone corner: as it is
     span = (group[-1][5] - group[0][4]) % total
-    if span > MAX_SPAN * size:
+    if len(group) > 1 and span > MAX_SPAN * size:
         return None  # a long chain of turns: a curve stored as a polyline
     turn = sum(t[1] for t in group)
     angle = math.pi - turn
     quarters = nearest_quarters(angle) if is_corner(angle) else 2
-    if quarters < 2:
-        return None  # convex: its curves and corners as they are
+    if angle < CONVEX_MIN:
+        return None  # a narrow slot's round end: its curves as they are
     if quarters == 2 and all(t[3] == "curve" or nearest_quarters(math.pi - t[1]) == 2
                              for t in group):
         return None  # flat, and so is each of its corners: nothing to change

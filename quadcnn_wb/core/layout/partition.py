@@ -65,12 +65,17 @@ def _boundary_key(domain, loop: int, seg: int, t: float):
 
 
 def build_partition(domain, streamlines, element_size: float, cuts=(),
-                    dissolve=frozenset(), flat_joints=frozenset()) -> Partition:
+                    dissolve=frozenset(), flat_joints=frozenset(),
+                    feature_corners=frozenset()) -> Partition:
     """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py),
     less the streamline edges whose origin is in ``dissolve`` (faces merged where a free
     face could not be filled).  ``flat_joints``: (loop, segment) of the loop vertices in a
     feature below the element size (BackgroundMesh.flat_joints): no vertex there, the
-    boundary edge runs through (mesh nodes along it at equal arc length)."""
+    boundary edge runs through (mesh nodes along it at equal arc length).
+    ``feature_corners``: (loop, segment, parameter, angle) of such features' corners
+    inside a curve (BackgroundMesh.feature_corners): vertices, as a loop's corners are,
+    where a face turns by the feature's whole turn (its curve turns a little within the
+    reach that measures a face's turns elsewhere)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -84,6 +89,10 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
         for si, curve in enumerate(loop):
             if curve.kind != "circle" and (li, si) not in flat_joints:
                 boundary_splits[li].add((si, 0.0))
+    bends = []  # (place, turn) of the feature corners
+    for li, si, t, angle in sorted(feature_corners):
+        boundary_splits[li].add(_boundary_key(domain, li, si, t)[2:])
+        bends.append((domain.loops[li][si].point(t), math.pi - angle))
     for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
         # A singular point on the boundary itself (its separatrix there has no length) is
         # that boundary vertex, not a second vertex in the same place.
@@ -125,9 +134,10 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
                                                element_size))
     while True:
-        faces, free, islands = _faces_to_blocks(np.array(verts.xy), edges, element_size)
-        slits = _slits(free, edges) | {e for island in islands for e, _ in island
-                                       if not edges[e].is_boundary}
+        faces, free, islands = _faces_to_blocks(np.array(verts.xy), edges, element_size,
+                                                _vertex_turns(verts.xy, bends, tol))
+        slits = _slits(free, edges) | _slivers(free, faces, edges, element_size) \
+            | {e for island in islands for e, _ in island if not edges[e].is_boundary}
         if not slits:
             break
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
@@ -344,6 +354,32 @@ def _slits(free, edges) -> set:
     return out
 
 
+SLIVER_WIDTH = 0.25  # element sizes: a free face thinner than this on average is a sliver
+
+
+def _slivers(free, faces, edges, h) -> set:
+    """The streamline edges of faces thinner than SLIVER_WIDTH that are no four-sided
+    block (free, or to be split round a middle vertex): a separatrix that runs along the
+    boundary (or along another) a fraction of an element off it leaves a face no quad
+    fits in, which its mesh line would only crowd.  Along the boundary, the face's
+    streamline edges go (the boundary is the line); between streamlines, the later
+    streamline's."""
+    walks = [face.halves for face in free]
+    walks += [tuple(h for side in sides for h in side) for _, sides in faces if len(sides) != 4]
+    out = set()
+    for halves in walks:
+        outline = _outline(edges, halves)
+        perimeter = float(np.hypot(*np.diff(outline, axis=0).T).sum())
+        if 2.0 * abs(_polygon_area(outline)) >= SLIVER_WIDTH * h * perimeter:
+            continue  # (a strip of width w and length l: area w l, perimeter 2 l)
+        inner = [e for e, _ in halves if not edges[e].is_boundary]
+        if len(inner) == len(halves):
+            last = max(edges[e].streamline for e in inner)
+            inner = [e for e in inner if edges[e].streamline == last]
+        out.update(inner)
+    return out
+
+
 def _end_vertex(domain, verts, where, xy, boundary_splits, line_index, tol):
     if where.kind == "singularity":
         return verts.get(("s", where.index), xy)
@@ -529,7 +565,18 @@ def _wrapped(angle: float) -> float:
     return math.atan2(math.sin(angle), math.cos(angle))
 
 
-def _faces_to_blocks(vertices, edges, h):
+def _vertex_turns(xy, bends, tol) -> dict:
+    """Vertex id -> turn of the feature corners among the vertices."""
+    out = {}
+    for place, turn in bends:
+        d = np.hypot(*(np.asarray(xy) - place).T)
+        k = int(np.argmin(d))
+        if d[k] <= tol:
+            out[k] = turn
+    return out
+
+
+def _faces_to_blocks(vertices, edges, h, vertex_turns=None):
     reach = 0.5 * h
     half = []  # (edge id, forward)
     out_dirs: dict = {}
@@ -581,7 +628,7 @@ def _faces_to_blocks(vertices, edges, h):
             islands.append(tuple(half[c] for c in cycle))  # the outside of an island
             continue
         try:
-            blocks.append(_block_of(cycle, half, edges, vertices, h, head))
+            blocks.append(_block_of(cycle, half, edges, vertices, h, head, vertex_turns or {}))
         except PartitionError as exc:
             places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
                       for c in cycle]
@@ -634,7 +681,7 @@ def _with_fourth_corner(turns, corner_at):
     return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
 
 
-def _block_of(cycle, half, edges, vertices, h, head):
+def _block_of(cycle, half, edges, vertices, h, head, vertex_turns):
     reach = 0.5 * h
     turns = []
     for k, hid in enumerate(cycle):
@@ -646,6 +693,8 @@ def _block_of(cycle, half, edges, vertices, h, head):
         d_in = -_direction(pin[::-1], min(reach, edges[e_in].length / 3))
         d_out = _direction(pout, min(reach, edges[e_out].length / 3))
         turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
+        if head(hid) in vertex_turns and edges[e_in].is_boundary and edges[e_out].is_boundary:
+            turn = vertex_turns[head(hid)]  # a feature corner, the boundary both sides
         turns.append(turn)
     turns = np.array(turns)
     # A turn at the very threshold (a 45° chamfer met by a field line along one of its
