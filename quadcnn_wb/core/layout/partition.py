@@ -133,15 +133,11 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = _one_vertex_per_place(edges, np.array(verts.xy), element_size, singular)
     edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
                                                element_size))
-    while True:
-        faces, free, islands = _faces_to_blocks(np.array(verts.xy), edges, element_size,
-                                                _vertex_turns(verts.xy, bends, tol))
-        slits = _slits(free, edges) | _slivers(free, faces, edges, element_size) \
-            | {e for island in islands for e, _ in island if not edges[e].is_boundary}
-        if not slits:
-            break
-        edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
-
+    turns = _vertex_turns(verts.xy, bends, tol)
+    # Without the slivers' edges where that leaves no more free faces than with them.
+    edges, faces, free, islands = min(
+        (_faces_without_slits(verts.xy, edges, element_size, turns, slivers)
+         for slivers in (True, False)), key=lambda option: len(option[2]))
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
                                              unsplit=dissolve)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
@@ -150,6 +146,20 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     return _used_vertices_only(Partition(vertices=np.array(vertices), edges=edges,
                                          blocks=blocks, cuts=list(cuts), singular=singular,
                                          free_faces=free))
+
+
+def _faces_without_slits(xy, edges, h, turns, slivers: bool) -> tuple:
+    """(edges, faces, free faces, islands) once no slit, island outline (and, with
+    ``slivers``, sliver edge) is left."""
+    while True:
+        faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns)
+        slits = _slits(free, edges) \
+            | {e for island in islands for e, _ in island if not edges[e].is_boundary}
+        if slivers:
+            slits |= _slivers(free, faces, edges, h)
+        if not slits:
+            return edges, faces, free, islands
+        edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
 
 
 def _used_vertices_only(partition: Partition) -> Partition:
@@ -363,7 +373,10 @@ def _slivers(free, faces, edges, h) -> set:
     boundary (or along another) a fraction of an element off it leaves a face no quad
     fits in, which its mesh line would only crowd.  Along the boundary, the face's
     streamline edges go (the boundary is the line); between streamlines, the later
-    streamline's."""
+    streamline's; but no edge whose loss would leave a line that ends on it hanging (its
+    T-junction gone, the face beyond turns back).  (build_partition keeps them all where
+    dropping them frees faces: the hexagon's separatrices side by side out of singular
+    points a hair apart collapse into one mesh line, zero segment counts, instead.)"""
     walks = [face.halves for face in free]
     walks += [tuple(h for side in sides for h in side) for _, sides in faces if len(sides) != 4]
     out = set()
@@ -372,11 +385,13 @@ def _slivers(free, faces, edges, h) -> set:
         perimeter = float(np.hypot(*np.diff(outline, axis=0).T).sum())
         if 2.0 * abs(_polygon_area(outline)) >= SLIVER_WIDTH * h * perimeter:
             continue  # (a strip of width w and length l: area w l, perimeter 2 l)
-        inner = [e for e, _ in halves if not edges[e].is_boundary]
+        inner = {e for e, _ in halves if not edges[e].is_boundary}
         if len(inner) == len(halves):
             last = max(edges[e].streamline for e in inner)
-            inner = [e for e in inner if edges[e].streamline == last]
-        out.update(inner)
+            inner = {e for e in inner if edges[e].streamline == last}
+        rest = [edge for e, edge in enumerate(edges) if e not in inner]
+        if len(_without_dangling(rest)) == len(rest):
+            out.update(inner)  # (not where it would leave a line that ends on it hanging)
     return out
 
 
