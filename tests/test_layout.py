@@ -80,11 +80,17 @@ def test_a_split_whose_blocks_cannot_be_filled_is_left_whole_in_the_rebuild():
 
     from quadcnn_wb.core.layout.cuts import connecting_cuts
     from quadcnn_wb.core.layout.partition import build_partition
-    from quadcnn_wb.core.pipeline import _t_mesh, background_and_field, trace_streamlines
+    from quadcnn_wb.core.pipeline import (
+        _t_mesh,
+        background_and_field,
+        default_size,
+        trace_streamlines,
+    )
 
     domain = named_domain("hexagon")
     background, field = background_and_field(domain, 2048, {})
-    lines = _t_mesh(domain, background, trace_streamlines(domain, background, field))
+    lines = _t_mesh(domain, background, trace_streamlines(domain, background, field),
+                    default_size(domain))
     cuts = connecting_cuts(domain, background, field, lines)
     h = background.element_size
     first = build_partition(domain, lines, h, cuts)

@@ -19,6 +19,7 @@ from .input.domain import Domain
 from .input.features import boundary_features
 from .input.pose import default_size
 from .input.small_holes import squared_holes
+from .layout.cusps import with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import build_partition
@@ -207,7 +208,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
         else:
             lines = trace_streamlines(domain, background, field)
             timings["tracing"] = time.perf_counter() - clock
-        lines = _t_mesh(domain, background, lines)
+        lines = _t_mesh(domain, background, lines, size)
     else:
         background, field, lines, timings = traced
         timings = dict(timings)
@@ -230,7 +231,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
             clock = time.perf_counter()
             lines = tuple(dataclasses.replace(line, fallback=True)
                           for line in trace_streamlines(domain, background, field))
-            lines = _t_mesh(domain, background, lines)
+            lines = _t_mesh(domain, background, lines, size)
             timings["fallback_tracing"] = time.perf_counter() - clock
             cuts, partition, counts, mesh = blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
@@ -269,9 +270,11 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
                       problem=problem)
 
 
-def _t_mesh(domain, background, lines) -> tuple:
-    """Traces cut where they first meet an earlier one (see layout.motorcycle)."""
-    return stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
+def _t_mesh(domain, background, lines, size) -> tuple:
+    """Traces cut where they first meet an earlier one (see layout.motorcycle), and a
+    kite at each cusp's tip (layout.cusps)."""
+    lines = stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
+    return with_cusp_kites(domain, background, lines, size)
 
 
 UNBALANCED = "no segment counts make its opposite sides equal"

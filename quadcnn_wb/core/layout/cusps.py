@@ -1,0 +1,145 @@
+"""A cusp's tip as one quad: the kite that ends the separatrix running into it.
+
+Where two boundary curves meet at a cusp (tangent arcs, a crank web's horns: an interior
+angle below the field's SHARP_LOW), the cross field carries on through the tip as along
+a smooth stretch (the short way round, framefield.boundary_values), and the singular
+point it puts beside the cusp sends a separatrix into the tip.  Cut along that line, the
+tip gets two quads, each with a corner of half the cusp's angle, and the faces either
+side cannot be blocks: the field's count wants the tip to hold no quad at all (+2 by
+Poincaré-Hopf), two quads give it nothing (0), and the two units missing turned up as
+folded block maps (0051 crank web: four faces of unstructured quads at the default size).
+
+Every quad mesh puts at least one quad at a tip, so the layout gives it exactly one and
+makes up the other unit where the field's count asks for it: the separatrix stops one
+element short of the tip at a point M, from which two short arms run back out to the
+two sides, leaning towards the tip (120° between them, 120° from each to the
+separatrix).  The kite tip-L-M-R is a block with one quad's corner at the tip, and M is
+a valence-3 vertex, the standard split of a three-sided tip.  Nothing here hangs on the
+frame of the input: the kite is measured along the separatrix and the boundary.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..field.framefield import SHARP_LOW
+from .crossings import cumulative_length
+from .streamlines import Endpoint, Streamline
+
+KITE_REACH = 1.0  # element sizes from the tip to the kite's inner corner M ...
+KITE_SHARE = 0.5  # ... but at most this share of the separatrix
+ARM_LEAN = math.radians(60)  # between an arm and the direction from M back to the tip
+ARM_POINTS = 4  # polyline points per arm
+SEARCH = 3.0  # reaches along each side searched for the point nearest M
+SEARCH_SAMPLES = 600
+
+
+def with_cusp_kites(domain, background, lines, size: float) -> tuple:
+    """``lines`` with a kite at every cusp that exactly one of them runs into."""
+    cusps = {int(n) for n, angle in zip(background.corner_nodes, background.corner_angles)
+             if angle < SHARP_LOW}
+    lines = list(lines)
+    for node in sorted(cusps):
+        into = [k for k, line in enumerate(lines)
+                if any(end.kind == "corner" and end.index == node
+                       for end in (line.start, line.end))]
+        if len(into) == 1:
+            lines = _kite(domain, lines, into[0], node, size)
+    return tuple(lines)
+
+
+def _kite(domain, lines, k, node, size) -> list:
+    """Lines with line k stopped at the kite's inner corner and the kite's arms added;
+    unchanged where the kite does not fit (a line ends on the stretch it would cut off,
+    or the tip's sides do not reach past M)."""
+    line = lines[k]
+    if not (line.end.kind == "corner" and line.end.index == node):
+        return lines  # a line from the tip (none is traced so) would start on a junction
+    towards_tip = np.asarray(line.points, dtype=float)
+    tip_end = line.end
+    cum = cumulative_length(towards_tip)
+    total = float(cum[-1])
+    reach = min(KITE_REACH * size, KITE_SHARE * total)
+    if reach <= 0.0:
+        return lines
+    kept = total - reach  # arc length of the line's part that stays, from its far end
+    for other in lines:
+        if other.end.kind == "streamline" and other.end.index == k:
+            if other.end.param * total > kept:
+                return lines  # a junction on the part that goes
+    middle = _point_at(towards_tip, cum, kept)
+    stays = np.vstack([towards_tip[cum < kept], middle])
+    loop = domain.loops[tip_end.loop]
+    tip = (tip_end.segment, tip_end.param)
+    sides = [_arm_end(loop, tip, step, middle, reach) for step in (1, -1)]
+    if any(side is None for side in sides):
+        return lines
+    (seg_a, t_a, a), (seg_b, t_b, b) = sides
+    arm_a = np.linspace(a, middle, ARM_POINTS + 1)
+    arm_b = np.linspace(middle, b, ARM_POINTS + 1)
+    arms = np.vstack([arm_a, arm_b[1:]])
+    share = float(cumulative_length(arm_a)[-1] / cumulative_length(arms)[-1])
+    kite = len(lines)
+    junction = Endpoint("streamline", kite, param=share)
+    out = list(lines)
+    out[k] = dataclasses.replace(line, points=stays, end=junction)
+    for j, other in enumerate(out):  # junctions on line k: the same places, new fractions
+        if other.end.kind == "streamline" and other.end.index == k:
+            out[j] = dataclasses.replace(other, end=dataclasses.replace(
+                other.end, param=other.end.param * total / kept))
+    out.append(Streamline(arms, Endpoint("boundary", -1, tip_end.loop, seg_a, t_a),
+                          Endpoint("boundary", -1, tip_end.loop, seg_b, t_b)))
+    return out
+
+
+def _point_at(pts, cum, s) -> np.ndarray:
+    i = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
+    f = (s - cum[i]) / (cum[i + 1] - cum[i]) if cum[i + 1] > cum[i] else 0.0
+    return pts[i] + f * (pts[i + 1] - pts[i])
+
+
+def _arm_end(loop, tip, step, middle, reach):
+    """(segment, parameter, point) where an arm from ``middle`` meets the side that leaves
+    the tip in direction ``step`` (+1 along the loop, -1 against it): the side's point
+    nearest ``middle``, moved towards the tip so that the arm leans ARM_LEAN off the
+    way back to the tip; None where the nearest point is the tip or lies past the
+    stretch searched."""
+    places = _walk(loop, tip, step, SEARCH * reach, SEARCH_SAMPLES)
+    xy = np.array([loop[seg].point(t) for seg, t, _ in places])
+    nearest = int(np.argmin(np.hypot(*(xy - middle).T)))
+    if nearest == 0 or nearest == len(places) - 1:
+        return None
+    along = places[nearest][2]
+    gap = float(np.hypot(*(xy[nearest] - middle)))
+    back = min(gap / math.tan(ARM_LEAN), 0.5 * along)
+    seg, t, _ = _walk(loop, tip, step, along - back, 1)[-1]
+    return seg, t, loop[seg].point(t)
+
+
+def _walk(loop, start, step, distance, samples) -> list:
+    """(segment, parameter, arc length) at ``samples`` equal steps from ``start`` to
+    ``distance`` along the loop in direction ``step``."""
+    seg, t = start
+    n = len(loop)
+    if step < 0 and t <= 0.0:
+        seg, t = (seg - 1) % n, 1.0
+    if step > 0 and t >= 1.0:
+        seg, t = (seg + 1) % n, 0.0
+    out, covered = [], 0.0
+    targets = np.linspace(0.0, distance, samples + 1)[1:] if samples > 1 else [distance]
+    for target in targets:
+        while True:
+            length = loop[seg].length
+            room = (1.0 - t if step > 0 else t) * length
+            if target - covered <= room or length == 0.0:
+                dt = (target - covered) / length if length else 0.0
+                t_here = t + step * dt
+                out.append((seg, float(np.clip(t_here, 0.0, 1.0)), float(target)))
+                break
+            covered += room
+            seg = (seg + step) % n
+            t = 0.0 if step > 0 else 1.0
+    return out
