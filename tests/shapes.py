@@ -42,6 +42,10 @@ def stadium():
             {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]
 
 
+def crescent():
+    return [{"arc": [[0, 0], [5, 4], [10, 0]]}, {"arc": [[10, 0], [5, 3], [0, 0]]}]
+
+
 from quadcnn_wb.core.input.transform import similarity as rotation  # noqa: E402,F401
 from quadcnn_wb.core.input.transform import transform_domain_json as transform_domain  # noqa: E402,F401
 
@@ -69,6 +73,9 @@ OWN_SHAPES = {
     "thin wall": ([thin_wall()], 0, 0),
     "T shape": ([polygon([[0, 0], [1, 0], [1, 2], [2, 2], [2, 3], [-1, 3], [-1, 2],
                           [0, 2]])], 0, 0),
+    # Two arcs through the same ends, 15.4° apart there: two cusps, which make up the
+    # disk's count (the field carries on through them), so no singular point.
+    "crescent": ([crescent()], 0, 0),
 }
 
 

@@ -89,8 +89,8 @@ def test_a_split_whose_blocks_cannot_be_filled_is_left_whole_in_the_rebuild():
 
     domain = named_domain("hexagon")
     background, field = background_and_field(domain, 2048, {})
-    lines = _t_mesh(domain, background, trace_streamlines(domain, background, field),
-                    default_size(domain))
+    lines = _t_mesh(domain, background, field,
+                    trace_streamlines(domain, background, field), default_size(domain))
     cuts = connecting_cuts(domain, background, field, lines)
     h = background.element_size
     first = build_partition(domain, lines, h, cuts)

@@ -18,7 +18,9 @@ from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.quantize import side_counts
 from quadcnn_wb.core.pipeline import mesh_domain
 
-MESHABLE_OWN = list(OWN_SHAPES)
+# The crescent's 15° tips bound its worst quad, and its kites' inner corners are
+# irregular beside no singular point: test_cusps checks it for what a cusp allows.
+MESHABLE_OWN = [name for name in OWN_SHAPES if name != "crescent"]
 
 
 @functools.cache

@@ -208,7 +208,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
         else:
             lines = trace_streamlines(domain, background, field)
             timings["tracing"] = time.perf_counter() - clock
-        lines = _t_mesh(domain, background, lines, size)
+        lines = _t_mesh(domain, background, field, lines, size)
     else:
         background, field, lines, timings = traced
         timings = dict(timings)
@@ -231,7 +231,7 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
             clock = time.perf_counter()
             lines = tuple(dataclasses.replace(line, fallback=True)
                           for line in trace_streamlines(domain, background, field))
-            lines = _t_mesh(domain, background, lines, size)
+            lines = _t_mesh(domain, background, field, lines, size)
             timings["fallback_tracing"] = time.perf_counter() - clock
             cuts, partition, counts, mesh = blocks_and_mesh(domain, background, field, lines,
                                                              size, smoothing, timings)
@@ -270,11 +270,11 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
                       problem=problem)
 
 
-def _t_mesh(domain, background, lines, size) -> tuple:
+def _t_mesh(domain, background, field, lines, size) -> tuple:
     """Traces cut where they first meet an earlier one (see layout.motorcycle), and a
     kite at each cusp's tip (layout.cusps)."""
     lines = stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
-    return with_cusp_kites(domain, background, lines, size)
+    return with_cusp_kites(domain, background, field, lines, size)
 
 
 UNBALANCED = "no segment counts make its opposite sides equal"

@@ -26,49 +26,105 @@ import math
 import numpy as np
 
 from ..field.framefield import SHARP_LOW
-from .crossings import cumulative_length
+from .crossings import crossings, cumulative_length, end_places
 from .streamlines import Endpoint, Streamline
+from .tracing import integrate
 
 KITE_REACH = 1.0  # element sizes from the tip to the kite's inner corner M ...
-KITE_SHARE = 0.5  # ... but at most this share of the separatrix
+KITE_SHARE = 0.4  # ... but at most this share of the separatrix (less than half: a line
+# between two cusps keeps its middle)
 ARM_LEAN = math.radians(60)  # between an arm and the direction from M back to the tip
 ARM_POINTS = 4  # polyline points per arm
 SEARCH = 3.0  # reaches along each side searched for the point nearest M
 SEARCH_SAMPLES = 600
 
 
-def with_cusp_kites(domain, background, lines, size: float) -> tuple:
-    """``lines`` with a kite at every cusp that exactly one of them runs into."""
-    cusps = {int(n) for n, angle in zip(background.corner_nodes, background.corner_angles)
-             if angle < SHARP_LOW}
+def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
+    """``lines`` with a kite at every cusp that exactly one of them runs into.  A cusp
+    that none runs into (no singular point beside it: a lens between two bores, whose
+    two cusps make up the disk's count) gets one, traced from the tip along the field
+    until it meets another line or the boundary."""
+    cusps = {int(n): float(a) for n, a in zip(background.corner_nodes,
+                                              background.corner_angles) if a < SHARP_LOW}
     lines = list(lines)
     for node in sorted(cusps):
-        into = [k for k, line in enumerate(lines)
-                if any(end.kind == "corner" and end.index == node
-                       for end in (line.start, line.end))]
-        if len(into) == 1:
-            lines = _kite(domain, lines, into[0], node, size)
+        if not _lines_at(lines, node):
+            lines.extend(_from_tip(domain, background, field, lines, node))
+    cuts = []  # (line, its end at the tip: 0 start, 1 end, reach), from the lines as traced
+    for node in sorted(cusps):
+        at = _lines_at(lines, node)
+        if len(at) == 1:
+            k, which = at[0]
+            total = float(cumulative_length(np.asarray(lines[k].points, dtype=float))[-1])
+            cuts.append((k, which, min(KITE_REACH * size, KITE_SHARE * total)))
+    for k, which, reach in cuts:
+        lines = _kite(domain, lines, k, which, reach)
     return tuple(lines)
 
 
-def _kite(domain, lines, k, node, size) -> list:
-    """Lines with line k stopped at the kite's inner corner and the kite's arms added;
-    unchanged where the kite does not fit (a line ends on the stretch it would cut off,
-    or the tip's sides do not reach past M)."""
+def _lines_at(lines, node) -> list:
+    """(line, 0 for its start or 1 for its end) of the lines that end at a corner node."""
+    return [(k, which) for k, line in enumerate(lines)
+            for which, end in enumerate((line.start, line.end))
+            if end.kind == "corner" and end.index == node]
+
+
+def _from_tip(domain, background, field, lines, node) -> list:
+    """A line traced from the cusp at ``node`` along its bisector, stopped where it first
+    crosses one of ``lines`` (a T-junction there), as the motorcycle graph stops traces."""
+    k = int(np.nonzero(background.boundary_nodes == node)[0][0])
+    li, si = int(background.boundary_loop[k]), int(background.boundary_segment[k])
+    t = float(background.boundary_param[k])
+    loop = domain.loops[li]
+    before = loop[(si - 1) % len(loop)] if t <= 0.0 else loop[si]
+    after = loop[si] if t <= 0.0 else loop[(si + 1) % len(loop)]
+    bisector = after.tangent(0.0) - before.tangent(1.0)
+    if not np.hypot(*bisector) > 0:
+        return []
+    bisector = bisector / np.hypot(*bisector)
+    tip = background.nodes[node]
+    h = background.element_size
+    tris = np.nonzero((background.triangles == node).any(axis=1))[0]
+    probe = np.repeat((tip + 1e-6 * h * bisector)[None], len(tris), axis=0)
+    start = int(tris[np.argmax(background.walker.barycentric(tris, probe).min(axis=1))])
+    (line,) = integrate(domain, background, field,
+                        [(tip, bisector, start, Endpoint("corner", node, li, si, t))])
+    every = list(lines) + [line]
+    new = len(lines)
+    hits = [((s_i, j, s_j) if i == new else (s_j, i, s_i))
+            for (i, s_i), (j, s_j), _ in crossings(
+                [np.asarray(x.points, dtype=float) for x in every], h, 1e-9 * domain.size,
+                [end_places(x) for x in every])
+            if new in (i, j)]
+    if hits:
+        s, j, s_j = min(hits)
+        pts = np.asarray(line.points, dtype=float)
+        cum = cumulative_length(pts)
+        other = cumulative_length(np.asarray(lines[j].points, dtype=float))[-1]
+        line = dataclasses.replace(
+            line, points=np.vstack([pts[cum < s], _point_at(pts, cum, s)]),
+            end=Endpoint("streamline", j, param=float(s_j / other)))
+    return [line]
+
+
+def _kite(domain, lines, k, which, reach) -> list:
+    """Lines with line k stopped at the kite's inner corner, ``reach`` from the tip at
+    its start (``which`` 0) or end (1), and the kite's arms added; unchanged where the
+    kite does not fit (a line ends on the stretch it would cut off, or the nearest
+    point of a side is the tip)."""
     line = lines[k]
-    if not (line.end.kind == "corner" and line.end.index == node):
-        return lines  # a line from the tip (none is traced so) would start on a junction
-    towards_tip = np.asarray(line.points, dtype=float)
-    tip_end = line.end
+    pts = np.asarray(line.points, dtype=float)
+    towards_tip = pts if which else pts[::-1]
+    tip_end = line.end if which else line.start
     cum = cumulative_length(towards_tip)
     total = float(cum[-1])
-    reach = min(KITE_REACH * size, KITE_SHARE * total)
-    if reach <= 0.0:
-        return lines
     kept = total - reach  # arc length of the line's part that stays, from its far end
+    if reach <= 0.0 or kept <= 0.0:
+        return lines
     for other in lines:
         if other.end.kind == "streamline" and other.end.index == k:
-            if other.end.param * total > kept:
+            s = other.end.param * total
+            if (s if which else total - s) > kept:
                 return lines  # a junction on the part that goes
     middle = _point_at(towards_tip, cum, kept)
     stays = np.vstack([towards_tip[cum < kept], middle])
@@ -82,14 +138,15 @@ def _kite(domain, lines, k, node, size) -> list:
     arm_b = np.linspace(middle, b, ARM_POINTS + 1)
     arms = np.vstack([arm_a, arm_b[1:]])
     share = float(cumulative_length(arm_a)[-1] / cumulative_length(arms)[-1])
-    kite = len(lines)
-    junction = Endpoint("streamline", kite, param=share)
+    junction = Endpoint("streamline", len(lines), param=share)
     out = list(lines)
-    out[k] = dataclasses.replace(line, points=stays, end=junction)
+    out[k] = dataclasses.replace(line, points=stays, end=junction) if which else \
+        dataclasses.replace(line, points=stays[::-1], start=junction)
+    shift = 0.0 if which else reach  # where the kept part starts along the old line
     for j, other in enumerate(out):  # junctions on line k: the same places, new fractions
         if other.end.kind == "streamline" and other.end.index == k:
             out[j] = dataclasses.replace(other, end=dataclasses.replace(
-                other.end, param=other.end.param * total / kept))
+                other.end, param=(other.end.param * total - shift) / kept))
     out.append(Streamline(arms, Endpoint("boundary", -1, tip_end.loop, seg_a, t_a),
                           Endpoint("boundary", -1, tip_end.loop, seg_b, t_b)))
     return out

@@ -107,14 +107,15 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
             if vid is None:
                 continue  # a T-junction end: resolved once the other line's vertices exist
             splits[k].append((pos if pos is not None else _length(pts), vid))
-    # T-junctions: a line ending on another splits the other there.
-    for k, (pts, (_, end)) in enumerate(zip(lines, ends)):
-        if end.kind == "streamline":
-            other = end.index
-            s = end.param * _length(lines[other])
-            vid = verts.get(("t", k), pts[-1])
-            splits[other].append((s, vid))
-            splits[k].append((_length(pts), vid))
+    # T-junctions: a line ending (or, at a cusp's kite, starting) on another splits the
+    # other there.
+    for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
+        for where, key, point, s_own in ((start, "t0", pts[0], 0.0),
+                                         (end, "t", pts[-1], _length(pts))):
+            if where.kind == "streamline":
+                vid = verts.get((key, k), point)
+                splits[where.index].append((where.param * _length(lines[where.index]), vid))
+                splits[k].append((s_own, vid))
     # Crossings between streamlines.
     for n, ((i, si), (j, sj), xy) in enumerate(crossings(lines, element_size, tol,
                                                         [end_places(s) for s in every])):

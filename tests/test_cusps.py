@@ -1,0 +1,59 @@
+"""Cusps (interior angle below 22.5°: tangent arcs, a crank web's horns): the tip holds
+one quad, closed by a kite whose inner corner is a valence-3 vertex (layout.cusps), and
+the faces beside it are blocks.  crank_arm_web's cusps, which a singular point's
+separatrix runs into, are in test_corpus."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from shapes import named_domain, rotation, transform_domain
+
+from quadcnn_wb.core.input.corners import interior_angle
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.pose import diameter
+from quadcnn_wb.core.pipeline import mesh_domain
+
+
+def cusp_tips(domain):
+    loop = domain.loops[0]
+    return [(loop[k].p1, interior_angle(loop[k], loop[(k + 1) % len(loop)]))
+            for k in range(len(loop))
+            if interior_angle(loop[k], loop[(k + 1) % len(loop)]) < math.radians(22.5)]
+
+
+@pytest.mark.parametrize("divisor", [None, 100])
+def test_a_crescent_is_two_kites_and_a_ladder(divisor):
+    # No singular point: no line runs into either tip, so each gets one traced from it
+    # along the field; the one from the first tip meets the second, and both kites cut it.
+    domain = named_domain("crescent")
+    result = mesh_domain(domain, size=None if divisor is None else diameter(domain) / divisor)
+    tips = cusp_tips(domain)
+    assert len(tips) == 2 and not result.reference.field.singularities
+    assert result.structured_share == 1.0, result.problem
+    mesh = result.mesh
+    for tip, _ in tips:
+        node = np.nonzero(np.hypot(*(mesh.nodes - tip).T) < 1e-9)[0]
+        assert len(node) == 1 and np.sum(mesh.quads == node[0]) == 1
+        (quad,) = np.nonzero((mesh.quads == node[0]).any(axis=1))[0]
+        opposite = mesh.quads[quad][(list(mesh.quads[quad]).index(node[0]) + 2) % 4]
+        assert np.sum(mesh.quads == opposite) == 3
+    # Irregular: the kites' inner corners only; the worst quad is a tip's, about as good
+    # as its angle allows (the tip quad's sides are chords of the arcs).
+    assert result.quality["irregular_vertices"] == 2
+    worst_tip = min(math.sin(angle) for _, angle in tips)
+    assert 0.95 * worst_tip <= result.quality["min_scaled_jacobian"] <= worst_tip
+
+
+def test_a_crescent_gets_the_same_mesh_in_every_pose():
+    loops = {"loops": named_domain("crescent").to_json()["loops"]}
+    seen = set()
+    for matrix, shift in [(rotation(0), (0, 0)), (rotation(37), (0, 0)),
+                          (rotation(211, mirror=True), (1e4, -1e4)),
+                          (rotation(123, scale=1e-3), (0, 0))]:
+        result = mesh_domain(domain_from_json(transform_domain(loops, matrix, shift)))
+        q = result.quality
+        seen.add((q["blocks"], q["quads"], q["irregular_vertices"], result.structured_share))
+    assert len(seen) == 1
