@@ -134,3 +134,39 @@ def test_a_separatrix_running_along_the_boundary_leaves_no_sliver_face():
                 dict(segment=1, param=0.1))
     kept = build_partition(domain, [across, wide], 1.0)
     assert any(edge.streamline == 1 for edge in kept.edges)
+
+
+def test_a_sliver_edge_that_another_line_ends_on_stays():
+    # The glancing trace of the test above, but now another line ends on it (a T-junction
+    # half way along): dropping the sliver's edge would leave that line hanging and the
+    # face beyond turning back, so the sliver rule keeps it (the line is then a block
+    # side, the strip a face of its own).  At element size 0.1 the strip (0.04 to 0 thick)
+    # is under a quarter element wide, and the T end lies two tenths of an element off
+    # the boundary, a place of its own.
+    import numpy as np
+
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.partition import build_partition
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    loop = [{"line": [[0, 0], [10, 0]]}, {"line": [[10, 0], [10, 1]]},
+            {"line": [[10, 1], [0, 1]]}, {"line": [[0, 1], [0, 0]]}]
+    domain = domain_from_json({"loops": [loop]})
+    xs = np.linspace(0.0, 9.9, 100)
+    glancing = Streamline(np.column_stack([xs, 0.04 * (1 - xs / 9.9)]),
+                          Endpoint("boundary", loop=0, segment=3, param=0.96),
+                          Endpoint("boundary", loop=0, segment=0, param=0.99))
+    half = float(np.hypot(*np.diff(glancing.points[:51], axis=0).T).sum())
+    total = float(np.hypot(*np.diff(glancing.points, axis=0).T).sum())
+    t_end = glancing.points[50]
+    down = Streamline(np.array([[t_end[0], 1.0], t_end]),
+                      Endpoint("boundary", loop=0, segment=2, param=1 - t_end[0] / 10),
+                      Endpoint("streamline", 0, param=half / total))
+    alone = build_partition(domain, [glancing], 0.1)
+    assert not any(edge.streamline == 0 for edge in alone.edges)  # a sliver: it goes
+    both = build_partition(domain, [glancing, down], 0.1)
+    assert any(edge.streamline == 0 for edge in both.edges)
+    assert any(edge.streamline == 1 for edge in both.edges)
+    t_vertex = int(np.argmin(np.hypot(*(both.vertices - t_end).T)))
+    assert np.hypot(*(both.vertices[t_vertex] - t_end)) < 1e-9
+    assert sum(t_vertex in (edge.a, edge.b) for edge in both.edges) >= 3

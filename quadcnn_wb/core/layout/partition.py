@@ -135,10 +135,13 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
                                                element_size))
     turns = _vertex_turns(verts.xy, bends, tol)
-    # Without the slivers' edges where that leaves no more free faces than with them.
-    edges, faces, free, islands = min(
-        (_faces_without_slits(verts.xy, edges, element_size, turns, slivers)
-         for slivers in (True, False)), key=lambda option: len(option[2]))
+    # Without the slivers' edges where that leaves no more free faces than with them
+    # (where no sliver edge went, the two builds are one).
+    thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True)
+    if thinned[4]:
+        kept = _faces_without_slits(verts.xy, edges, element_size, turns, False)
+        thinned = kept if len(kept[2]) < len(thinned[2]) else thinned
+    edges, faces, free, islands, _ = thinned
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
                                              unsplit=dissolve)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
@@ -150,16 +153,19 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
 
 
 def _faces_without_slits(xy, edges, h, turns, slivers: bool) -> tuple:
-    """(edges, faces, free faces, islands) once no slit, island outline (and, with
-    ``slivers``, sliver edge) is left."""
+    """(edges, faces, free faces, islands, whether a sliver edge went) once no slit,
+    island outline (and, with ``slivers``, sliver edge) is left."""
+    thinned = False
     while True:
         faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns)
         slits = _slits(free, edges) \
             | {e for island in islands for e, _ in island if not edges[e].is_boundary}
         if slivers:
-            slits |= _slivers(free, faces, edges, h)
+            thin = _slivers(free, faces, edges, h) - slits
+            thinned = thinned or bool(thin)
+            slits |= thin
         if not slits:
-            return edges, faces, free, islands
+            return edges, faces, free, islands, thinned
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
 
 
