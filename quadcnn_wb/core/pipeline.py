@@ -8,6 +8,7 @@ them without recomputing.
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 from dataclasses import dataclass, field
 
@@ -405,7 +406,10 @@ def free_face_problem(partition: Partition) -> str:
     """What the result says when some faces got unstructured quads."""
     if not partition.free_faces:
         return ""
-    reasons = sorted({face.reason.split(" near ")[0] for face in partition.free_faces})
+    # Without the places: one reason for all faces of a kind ("a block has 5 corners
+    # instead of 4"; split at " near " it was only "a block").
+    reasons = sorted({re.sub(r" near \([^)]*\)", "", face.reason)
+                      for face in partition.free_faces})
     return (f"{len(partition.free_faces)} of {len(partition.free_faces) + len(partition.blocks)}"
             f" faces are no blocks ({'; '.join(reasons)}): unstructured quads there")
 
