@@ -11,6 +11,13 @@ def cumulative_length(points: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
 
 
+def point_at(points: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
+    """The polyline's point at arc length ``s`` (``cum``: its cumulative_length)."""
+    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(points) - 2))
+    f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
+    return points[k] + min(max(f, 0.0), 1.0) * (points[k + 1] - points[k])
+
+
 def end_places(line) -> list:
     """(point, places) at both ends of a streamline: the singular point or corner it leaves
     or reaches, or ("line", j) when it ends on line j."""

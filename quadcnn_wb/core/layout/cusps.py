@@ -26,7 +26,8 @@ import math
 import numpy as np
 
 from ..field.framefield import SHARP_LOW
-from .crossings import crossings, cumulative_length, end_places
+from .crossings import crossings, cumulative_length, end_places, point_at
+from .field_rules import corner_endpoint, start_triangle
 from .streamlines import Endpoint, Streamline
 from .tracing import integrate
 
@@ -44,14 +45,14 @@ def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
     that none runs into (no singular point beside it: a lens between two bores, whose
     two cusps make up the disk's count) gets one, traced from the tip along the field
     until it meets another line or the boundary."""
-    cusps = {int(n): float(a) for n, a in zip(background.corner_nodes,
-                                              background.corner_angles) if a < SHARP_LOW}
+    cusps = sorted(int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
+                   if a < SHARP_LOW)
     lines = list(lines)
-    for node in sorted(cusps):
+    for node in cusps:
         if not _lines_at(lines, node):
             lines.extend(_from_tip(domain, background, field, lines, node))
     cuts = []  # (line, its end at the tip: 0 start, 1 end, reach), from the lines as traced
-    for node in sorted(cusps):
+    for node in cusps:
         at = _lines_at(lines, node)
         if len(at) == 1:
             k, which = at[0]
@@ -72,10 +73,9 @@ def _lines_at(lines, node) -> list:
 def _from_tip(domain, background, field, lines, node) -> list:
     """A line traced from the cusp at ``node`` along its bisector, stopped where it first
     crosses one of ``lines`` (a T-junction there), as the motorcycle graph stops traces."""
-    k = int(np.nonzero(background.boundary_nodes == node)[0][0])
-    li, si = int(background.boundary_loop[k]), int(background.boundary_segment[k])
-    t = float(background.boundary_param[k])
-    loop = domain.loops[li]
+    corner = corner_endpoint(background, node)
+    si, t = corner.segment, corner.param
+    loop = domain.loops[corner.loop]
     before = loop[(si - 1) % len(loop)] if t <= 0.0 else loop[si]
     after = loop[si] if t <= 0.0 else loop[(si + 1) % len(loop)]
     bisector = after.tangent(0.0) - before.tangent(1.0)
@@ -85,10 +85,8 @@ def _from_tip(domain, background, field, lines, node) -> list:
     tip = background.nodes[node]
     h = background.element_size
     tris = np.nonzero((background.triangles == node).any(axis=1))[0]
-    probe = np.repeat((tip + 1e-6 * h * bisector)[None], len(tris), axis=0)
-    start = int(tris[np.argmax(background.walker.barycentric(tris, probe).min(axis=1))])
-    (line,) = integrate(domain, background, field,
-                        [(tip, bisector, start, Endpoint("corner", node, li, si, t))])
+    start = start_triangle(background.walker, tris, tip, bisector, h)
+    (line,) = integrate(domain, background, field, [(tip, bisector, start, corner)])
     every = list(lines) + [line]
     new = len(lines)
     hits = [((s_i, j, s_j) if i == new else (s_j, i, s_i))
@@ -102,7 +100,7 @@ def _from_tip(domain, background, field, lines, node) -> list:
         cum = cumulative_length(pts)
         other = cumulative_length(np.asarray(lines[j].points, dtype=float))[-1]
         line = dataclasses.replace(
-            line, points=np.vstack([pts[cum < s], _point_at(pts, cum, s)]),
+            line, points=np.vstack([pts[cum < s], point_at(pts, cum, s)]),
             end=Endpoint("streamline", j, param=float(s_j / other)))
     return [line]
 
@@ -126,7 +124,7 @@ def _kite(domain, lines, k, which, reach) -> list:
             s = other.end.param * total
             if (s if which else total - s) > kept:
                 return lines  # a junction on the part that goes
-    middle = _point_at(towards_tip, cum, kept)
+    middle = point_at(towards_tip, cum, kept)
     stays = np.vstack([towards_tip[cum < kept], middle])
     loop = domain.loops[tip_end.loop]
     tip = (tip_end.segment, tip_end.param)
@@ -150,12 +148,6 @@ def _kite(domain, lines, k, which, reach) -> list:
     out.append(Streamline(arms, Endpoint("boundary", -1, tip_end.loop, seg_a, t_a),
                           Endpoint("boundary", -1, tip_end.loop, seg_b, t_b)))
     return out
-
-
-def _point_at(pts, cum, s) -> np.ndarray:
-    i = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
-    f = (s - cum[i]) / (cum[i + 1] - cum[i]) if cum[i + 1] > cum[i] else 0.0
-    return pts[i] + f * (pts[i + 1] - pts[i])
 
 
 def _arm_end(loop, tip, step, middle, reach):

@@ -73,19 +73,26 @@ def separatrix_sources(mesh, field, walker, h) -> list:
     for t, tri in enumerate(mesh.triangles):
         for n in tri:
             incident.setdefault(int(n), []).append(t)
-    position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
     for cs in field.corner_sources:
-        k = position[cs.node]
-        corner = Endpoint("corner", cs.node, int(mesh.boundary_loop[k]),
-                          int(mesh.boundary_segment[k]), float(mesh.boundary_param[k]))
+        tris = np.array(incident[cs.node])
         for branch, d in enumerate(cs.directions):
-            probe = cs.xy + 1e-6 * h * d
-            tris = np.array(incident[cs.node])
-            b = walker.barycentric(tris, np.repeat(probe[None], len(tris), axis=0))
-            t0 = int(tris[np.argmax(b.min(axis=1))])
-            out.append((cs.xy, d, t0, Endpoint(corner.kind, corner.index, corner.loop,
-                                               corner.segment, corner.param, branch)))
+            out.append((cs.xy, d, start_triangle(walker, tris, cs.xy, d, h),
+                        corner_endpoint(mesh, cs.node, branch)))
     return out
+
+
+def start_triangle(walker, tris, xy, direction, h) -> int:
+    """Of the triangles ``tris`` round a boundary node at ``xy``, the one a trace leaving
+    it in ``direction`` goes into (the walk must begin on the direction's side)."""
+    probe = np.repeat((xy + 1e-6 * h * direction)[None], len(tris), axis=0)
+    return int(tris[np.argmax(walker.barycentric(tris, probe).min(axis=1))])
+
+
+def corner_endpoint(mesh, node: int, branch: int = -1) -> Endpoint:
+    """The Endpoint of a line leaving or reaching the boundary corner at ``node``."""
+    k = int(np.nonzero(mesh.boundary_nodes == node)[0][0])
+    return Endpoint("corner", int(node), int(mesh.boundary_loop[k]),
+                    int(mesh.boundary_segment[k]), float(mesh.boundary_param[k]), branch)
 
 
 def snap_targets(mesh, field) -> tuple[np.ndarray, list]:
@@ -94,10 +101,7 @@ def snap_targets(mesh, field) -> tuple[np.ndarray, list]:
     arrival)."""
     xy = [s.xy for s in field.singularities] + [c.xy for c in field.corner_sources]
     kind = [Endpoint("singularity", i) for i in range(len(field.singularities))]
-    for c in field.corner_sources:
-        k = int(np.nonzero(mesh.boundary_nodes == c.node)[0][0])
-        kind.append(Endpoint("corner", c.node, int(mesh.boundary_loop[k]),
-                             int(mesh.boundary_segment[k]), float(mesh.boundary_param[k])))
+    kind += [corner_endpoint(mesh, c.node) for c in field.corner_sources]
     return np.array(xy).reshape(-1, 2), kind
 
 

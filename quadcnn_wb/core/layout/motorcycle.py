@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .crossings import crossings, cumulative_length, end_places
+from .crossings import crossings, cumulative_length, end_places, point_at
 from .streamlines import Endpoint
 
 SOURCE_KINDS = ("singularity", "corner")
@@ -50,7 +50,7 @@ def _riders(lines) -> list:
         if line.start.kind in SOURCE_KINDS and line.end.kind in SOURCE_KINDS and len(pts) > 2:
             cum = cumulative_length(pts)
             half = 0.5 * cum[-1]
-            middle = _point_at(pts, cum, half)
+            middle = point_at(pts, cum, half)
             riders.append(_Rider(k, False, np.vstack([pts[cum < half], middle])))
             riders.append(_Rider(k, True, np.vstack([pts[cum > half][::-1], middle])))
         else:
@@ -58,12 +58,6 @@ def _riders(lines) -> list:
     for r in riders:
         r.stop = float(cumulative_length(r.points)[-1])
     return riders
-
-
-def _point_at(pts, cum, s):
-    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
-    f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
-    return pts[k] + min(max(f, 0.0), 1.0) * (pts[k + 1] - pts[k])
 
 
 def _rider_at(riders, by_line, line: int, s: float, length: float):

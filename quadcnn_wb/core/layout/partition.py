@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .crossings import crossings, end_places
+from .crossings import crossings, end_places, point_at
 from .partition_types import (
     BoundaryPiece,
     Edge,
@@ -290,7 +290,7 @@ def _side_by_side(first: Edge, second: Edge, gap: float) -> bool:
 
 def _resampled(points, n: int) -> np.ndarray:
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
-    return np.array([_at(points, cum, s) for s in np.linspace(0.0, cum[-1], n)])
+    return np.array([point_at(points, cum, s) for s in np.linspace(0.0, cum[-1], n)])
 
 
 def _without_dangling(edges) -> list:
@@ -458,16 +458,10 @@ def _split_line(pts, splits, k):
         if v_a == v_b or s_b - s_a <= 0:
             continue
         inner = pts[(cum > s_a) & (cum < s_b)]
-        pa = _at(pts, cum, s_a)
-        pb = _at(pts, cum, s_b)
+        pa = point_at(pts, cum, s_a)
+        pb = point_at(pts, cum, s_b)
         edges.append(Edge(points=np.vstack([pa, inner, pb]), a=v_a, b=v_b, streamline=k))
     return edges
-
-
-def _at(pts, cum, s):
-    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
-    f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
-    return pts[k] + min(max(f, 0.0), 1.0) * (pts[k + 1] - pts[k])
 
 
 def _boundary_edges(domain, li, positions, verts):
@@ -511,7 +505,7 @@ def _samples(curve, piece) -> int:
 def _direction(points: np.ndarray, reach: float) -> np.ndarray:
     """Unit direction from points[0] toward the point ``reach`` along the polyline."""
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
-    target = _at(points, cum, min(reach, cum[-1]))
+    target = point_at(points, cum, min(reach, cum[-1]))
     d = target - points[0]
     n = np.hypot(*d)
     if n == 0:
