@@ -29,6 +29,7 @@ ROUND_TRIP = 3.0  # a line may end on its own source once it went this many SNAP
 SNAP_CANDIDATES = 3  # a line is tested against this many nearest targets, nearest first
 MERGE = 0.75  # a second line onto a taken separatrix joins it once this close (in sizes)
 ARRIVAL_BLEND = 3.0  # an arriving line's last stretch (sizes) is bent onto the separatrix
+ARRIVAL_REACH = 3.0  # which separatrix a line arrives along is judged over this (sizes)
 
 
 # ----------------------------------------------------------------------------------------
@@ -200,10 +201,14 @@ def _arrival_branches(lines, h):
             continue
         tree = cKDTree(_densify(line.points, 0.25 * h))
         best, best_dist = end.branch, np.inf
-        for (kind, index, branch), own in leaving.items():
-            if (kind, index) != (end.kind, end.index):
-                continue
-            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= 3 * h]
+        own_traces = [(branch, own) for (kind, index, branch), own in leaving.items()
+                      if (kind, index) == (end.kind, end.index)]
+        # A separatrix that reaches the boundary within the compared reach is no way in
+        # from the interior, and its few points, all near the point, lie close to any
+        # line that arrives there: it is compared only when every one is that short.
+        reaching = [(b, own) for b, own in own_traces if not _stub(own, ARRIVAL_REACH * h)]
+        for branch, own in reaching or own_traces:
+            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= ARRIVAL_REACH * h]
             if len(near) < 2:
                 continue
             d = float(tree.query(near[1:])[0].mean())
@@ -211,6 +216,11 @@ def _arrival_branches(lines, h):
                 best, best_dist = branch, d
         out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
     return out
+
+
+def _stub(line, reach) -> bool:
+    """A trace that ends on the boundary less than ``reach`` from where it starts."""
+    return line.end.kind == "boundary" and line.length < reach
 
 
 def _along_own_separatrices(lines, h):
