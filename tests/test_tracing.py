@@ -212,3 +212,33 @@ def test_separatrices_of_one_singular_point_do_not_run_side_by_side():
     domain = load_domain(Path(__file__).parent / "corpus" / "sketch_bracket.brep")
     assert _closest_pair_of_separatrices(numerical_reference(domain, labels=False),
                                          1.5) > 0.5
+
+
+def test_a_line_is_not_read_as_arriving_along_a_stub_to_the_boundary():
+    """b52 (a public face, not in the corpus): a line came in beside a singular point's
+    long separatrix, half an element off, and its last step ran at the point with a
+    kink; its few points near the point lay closest to the point's short separatrix to
+    the nearby boundary (2 sizes long: nothing lies far from the point on it), so it was
+    read as arriving along that one, and the long separatrix was kept beside it, a
+    degenerate strip between the two.  A separatrix that reaches the boundary within the
+    compared reach is no way in from the interior."""
+    from quadcnn_wb.core.layout.field_rules import _arrival_branches
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    h = 1.0
+
+    def leaving(branch, end_xy, end):
+        points = np.linspace([0.0, 0.0], end_xy, 40)
+        return Streamline(points, Endpoint("singularity", 0, branch=branch), end)
+
+    stub = leaving(0, [-0.38, -0.38], Endpoint("boundary", loop=0, segment=0, param=0.5))
+    east = leaving(1, [12.0, 0.0], Endpoint("boundary", loop=0, segment=1, param=0.5))
+    north = leaving(2, [0.0, 12.0], Endpoint("boundary", loop=0, segment=2, param=0.5))
+    beside = np.vstack([np.linspace([12.0, 0.55], [0.4, 0.55], 40), [[0.0, 0.0]]])
+    arriving = Streamline(beside, Endpoint("singularity", 1, branch=0),
+                          Endpoint("singularity", 0, branch=0))
+    line = _arrival_branches([stub, east, north, arriving], h)[3]
+    assert line.end.branch == 1
+    # Where every separatrix is that short, they are still compared.
+    stub_only = _arrival_branches([stub, arriving], h)[1]
+    assert stub_only.end.branch == 0
