@@ -83,6 +83,31 @@ def test_every_face_is_block_structured(name):
         len(result.reference.field.singularities) + fillets + 4
 
 
+# At the second size of the corpus benchmark (bench.corpus: diameter / 100).  Not
+# perforated_plate: 100 s there (the benchmark command measures it; its default size is
+# an expected failure above).
+FINE_TOO_SLOW = {"perforated_plate"}
+# All in blocks there, with irregular vertices beyond the singular points and feature
+# corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
+# against 12; gmsh alg. 11 has 387 and 144).
+FINE_EXTRA_IRREGULAR = EXTRA_IRREGULAR | {"nist_ctc04_plate", "grabcad_part19"}
+
+
+@pytest.mark.parametrize("name", [
+    expected_failure(n, FINE_EXTRA_IRREGULAR, "irregular vertices the field does not have")
+    for n in MESHABLE if n not in FINE_TOO_SLOW])
+def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
+    from quadcnn_wb.core.input.pose import diameter
+
+    domain = load_domain(CORPUS / PARTS[name]["file"])
+    result = mesh_domain(domain, size=diameter(domain) / 100)
+    assert result.structured_share == 1.0, result.problem
+    assert result.quality["min_scaled_jacobian"] > 0
+    assert tiles_exactly(result.mesh.nodes, result.mesh.quads)
+    assert result.quality["irregular_vertices"] <= \
+        len(result.reference.field.singularities) + result.feature_corners + 4
+
+
 def test_a_face_without_blocks_says_so(monkeypatch):
     # No corpus face falls back as a whole any more; with no rebuild allowed, the free
     # faces of bracket_plate that cannot be filled on the 2048-node background (and no

@@ -189,8 +189,13 @@ def _arrival_branches(lines, h):
     streamline runs along.
 
     The direction of arrival alone is ambiguous next to a singular point (the field turns
-    fast there), so compare the arriving line with the point's own traced separatrices
-    over the first few element sizes: it arrives along the one it lies closest to.
+    fast there, and a snap's last step runs straight at the point from up to a size
+    away), so the line is seen from the point ARRIVAL_REACH sizes back along it and each
+    of the point's own traced separatrices as far out: it arrives along the one whose
+    heading is nearest its own.  (Distances between the polylines told them apart
+    poorly: a line half a size beside a separatrix was as far from it, on average, as
+    from a short separatrix to the nearby boundary, all of whose points lie near the
+    point; and a line a size beside one was as far from either side of a corner.)
     """
     leaving = {(ln.start.kind, ln.start.index, ln.start.branch): ln for ln in lines}
     out = []
@@ -199,23 +204,30 @@ def _arrival_branches(lines, h):
         if not any(key[:2] == (end.kind, end.index) for key in leaving):
             out.append(line)  # the boundary, or a convex corner: no separatrices there
             continue
-        tree = cKDTree(_densify(line.points, 0.25 * h))
-        best, best_dist = end.branch, np.inf
         own_traces = [(branch, own) for (kind, index, branch), own in leaving.items()
-                      if (kind, index) == (end.kind, end.index)]
+                      if (kind, index) == (end.kind, end.index) and len(own.points) > 1]
         # A separatrix that reaches the boundary within the compared reach is no way in
-        # from the interior, and its few points, all near the point, lie close to any
-        # line that arrives there: it is compared only when every one is that short.
+        # from the interior: it is compared only when every one is that short.
         reaching = [(b, own) for b, own in own_traces if not _stub(own, ARRIVAL_REACH * h)]
+        coming = heading(line.points[::-1], ARRIVAL_REACH * h)
+        best, best_cos = end.branch, -np.inf
         for branch, own in reaching or own_traces:
-            near = own.points[np.hypot(*(own.points - own.points[0]).T) <= ARRIVAL_REACH * h]
-            if len(near) < 2:
-                continue
-            d = float(tree.query(near[1:])[0].mean())
-            if d < best_dist:
-                best, best_dist = branch, d
+            cos = float(coming @ heading(own.points, ARRIVAL_REACH * h))
+            if cos > best_cos:
+                best, best_cos = branch, cos
         out.append(dataclasses.replace(line, end=dataclasses.replace(end, branch=best)))
     return out
+
+
+def heading(points, reach):
+    """Unit direction from a polyline's first point to its point ``reach`` along it (two
+    thirds of its length where it is shorter): where it heads, seen from that point."""
+    cum = cumulative_length(points)
+    reach = min(reach, 2.0 * cum[-1] / 3.0)
+    d = np.array([np.interp(reach, cum, points[:, 0]),
+                  np.interp(reach, cum, points[:, 1])]) - points[0]
+    n = float(np.hypot(*d))
+    return d / n if n > 0 else d
 
 
 def _stub(line, reach) -> bool:
@@ -255,15 +267,7 @@ def _leave_alike(first, second, h) -> bool:
     ALIKE_REACH sizes out (or two thirds of their length): a line is bent onto a
     separatrix only when it comes in beside it, never round to another side of the
     point.  Farther out than the snap's last step, whose kink points anywhere."""
-    def heading(points):
-        cum = cumulative_length(points)
-        reach = min(ALIKE_REACH * h, 2.0 * cum[-1] / 3.0)
-        d = np.array([np.interp(reach, cum, points[:, 0]),
-                      np.interp(reach, cum, points[:, 1])]) - points[0]
-        n = float(np.hypot(*d))
-        return d / n if n > 0 else d
-
-    return float(heading(first) @ heading(second)) >= ALIKE
+    return float(heading(first, ALIKE_REACH * h) @ heading(second, ALIKE_REACH * h)) >= ALIKE
 
 
 def _blended_tail(points, own, reach):
