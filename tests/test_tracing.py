@@ -242,3 +242,17 @@ def test_a_line_is_not_read_as_arriving_along_a_stub_to_the_boundary():
     # Where every separatrix is that short, they are still compared.
     stub_only = _arrival_branches([stub, arriving], h)[1]
     assert stub_only.end.branch == 0
+
+
+def test_an_exit_moved_onto_a_corner_bends_in_smoothly():
+    from quadcnn_wb.core.layout.tracing import _shifted_tail
+
+    path = [np.array([x, 0.0]) for x in np.linspace(0.0, 3.0, 31)]
+    moved = np.array(_shifted_tail(path, np.array([0.0, 0.2]), 1.5))
+    assert np.allclose(moved[-1], [3.0, 0.2]) and np.allclose(moved[:16], np.array(path)[:16])
+    # No kink: the last step turns by less than a tenth of the shift's angle at one step.
+    step = moved[-1] - moved[-2]
+    assert abs(np.degrees(np.arctan2(step[1], step[0]))) < 15
+    # A line shorter than twice the reach keeps its start where it is.
+    short = np.array(_shifted_tail(path[:6], np.array([0.0, 0.2]), 1.5))
+    assert np.allclose(short[0], [0.0, 0.0]) and np.allclose(short[-1], [0.5, 0.2])

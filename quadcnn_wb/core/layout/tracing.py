@@ -34,6 +34,7 @@ from .streamlines import Endpoint, Streamline
 
 STEP = 0.25  # integration step, in element sizes
 CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the corner
+SNAP_BLEND = 1.5  # ... and the line's last this many sizes bend smoothly onto it
 STRAIGHT_START = 0.75  # sizes a separatrix runs straight from its singular point
 
 
@@ -206,9 +207,34 @@ def _finish_exits(active, tri, exit_edge, old, pos, paths, ends, mesh, boundary,
             s = _segment_param(old[k], pos[i], pa, pb)
             li, si, par = boundary.on_edge(a, b, s)
         end, xy = boundary.endpoint(int(li), int(si), float(par), h)
-        paths[i][-1] = xy
+        exact = boundary.domain.loops[int(li)][int(si)].point(float(par))
+        paths[i][-1] = exact
+        paths[i] = _shifted_tail(paths[i], xy - exact, SNAP_BLEND * h)
         ends[i] = end
     return np.array(keep, dtype=np.int64)
+
+
+def _shifted_tail(path, shift, reach) -> list:
+    """The path with its end moved by ``shift`` and the stretch before it by less and
+    less, to nothing ``reach`` back along it.
+
+    An exit moved onto a nearby corner (CORNER_SNAP) by its last point alone came in
+    with a kink of up to a right angle, and the faces either side measured their turn
+    at the corner from the kink: one lost its corner there (a T-slot's 225° notch: a
+    three-cornered face, split round an extra irregular vertex).  Weights are a smooth
+    function of arc length to the end, so a turned copy gets the same line; the reach is
+    at most half the line, whose start stays where it is."""
+    if not np.any(shift):
+        return path
+    points = np.asarray(path, dtype=float)
+    from_end = np.concatenate([np.cumsum(np.hypot(*np.diff(points[::-1], axis=0).T))[::-1],
+                               [0.0]])
+    reach = min(reach, 0.5 * float(from_end[0]))  # the start stays where it is
+    if reach <= 0:
+        return path
+    x = np.clip(1.0 - from_end / reach, 0.0, 1.0)
+    moved = points + (x * x * (3.0 - 2.0 * x))[:, None] * shift
+    return list(moved)
 
 
 def _segment_param(p0, p1, a, b) -> float:
