@@ -214,14 +214,15 @@ def test_separatrices_of_one_singular_point_do_not_run_side_by_side():
                                          1.5) > 0.5
 
 
-def test_a_line_is_not_read_as_arriving_along_a_stub_to_the_boundary():
+def test_a_line_arrives_along_the_separatrix_it_heads_alike():
     """b52 (a public face, not in the corpus): a line came in beside a singular point's
     long separatrix, half an element off, and its last step ran at the point with a
-    kink; its few points near the point lay closest to the point's short separatrix to
-    the nearby boundary (2 sizes long: nothing lies far from the point on it), so it was
-    read as arriving along that one, and the long separatrix was kept beside it, a
-    degenerate strip between the two.  A separatrix that reaches the boundary within the
-    compared reach is no way in from the interior."""
+    kink; its few points near the point lay closest (on average) to the point's short
+    separatrix to the nearby boundary, so it was read as arriving along that one, and
+    the long one was kept beside it, a degenerate strip between the two.  Seen 3 sizes
+    out from the point, it heads along the long one.  A short separatrix still takes a
+    line that heads its way (AnalysisSitus 0080: a window's corner whose separatrix up
+    reaches the outer boundary within 2 sizes)."""
     from quadcnn_wb.core.layout.field_rules import _arrival_branches
     from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
 
@@ -239,9 +240,13 @@ def test_a_line_is_not_read_as_arriving_along_a_stub_to_the_boundary():
                           Endpoint("singularity", 0, branch=0))
     line = _arrival_branches([stub, east, north, arriving], h)[3]
     assert line.end.branch == 1
-    # Where every separatrix is that short, they are still compared.
-    stub_only = _arrival_branches([stub, arriving], h)[1]
-    assert stub_only.end.branch == 0
+
+    up = leaving(0, [0.0, 2.0], Endpoint("boundary", loop=0, segment=0, param=0.5))
+    left = leaving(1, [-12.0, 0.0], Endpoint("boundary", loop=0, segment=1, param=0.5))
+    slanted = np.linspace([12.0, 3.0], [0.0, 0.0], 40)
+    arriving = Streamline(slanted, Endpoint("singularity", 1, branch=0),
+                          Endpoint("singularity", 0, branch=1))
+    assert _arrival_branches([up, left, arriving], h)[2].end.branch == 0
 
 
 def test_an_exit_moved_onto_a_corner_bends_in_smoothly():

@@ -206,12 +206,9 @@ def _arrival_branches(lines, h):
             continue
         own_traces = [(branch, own) for (kind, index, branch), own in leaving.items()
                       if (kind, index) == (end.kind, end.index) and len(own.points) > 1]
-        # A separatrix that reaches the boundary within the compared reach is no way in
-        # from the interior: it is compared only when every one is that short.
-        reaching = [(b, own) for b, own in own_traces if not _stub(own, ARRIVAL_REACH * h)]
         coming = heading(line.points[::-1], ARRIVAL_REACH * h)
         best, best_cos = end.branch, -np.inf
-        for branch, own in reaching or own_traces:
+        for branch, own in own_traces:
             cos = float(coming @ heading(own.points, ARRIVAL_REACH * h))
             if cos > best_cos:
                 best, best_cos = branch, cos
@@ -228,11 +225,6 @@ def heading(points, reach):
                   np.interp(reach, cum, points[:, 1])]) - points[0]
     n = float(np.hypot(*d))
     return d / n if n > 0 else d
-
-
-def _stub(line, reach) -> bool:
-    """A trace that ends on the boundary less than ``reach`` from where it starts."""
-    return line.end.kind == "boundary" and line.length < reach
 
 
 def _along_own_separatrices(lines, h):
