@@ -121,14 +121,14 @@ def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
 
 def test_a_face_without_blocks_says_so(monkeypatch):
     # No corpus face falls back as a whole any more; with no rebuild allowed, the free
-    # faces of bracket_plate that cannot be filled on the 2048-node background (and no
+    # faces of nist_ctc04_plate that cannot be filled on the 2048-node background (and no
     # finer one allowed) leave no block partition, and the quads that stand in (gmsh's,
     # or the whole face as one free face where those fold) must say so everywhere.
     from quadcnn_wb.core import pipeline
 
     monkeypatch.setattr(pipeline, "FREEING_ROUNDS", 0)
     monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
-    result = mesh_domain(load_domain(CORPUS / PARTS["bracket_plate"]["file"]))
+    result = mesh_domain(load_domain(CORPUS / PARTS["nist_ctc04_plate"]["file"]))
     assert not result.structured and "no block structure" in result.problem
     assert "stand in" in result.problem and result.quality["min_scaled_jacobian"] > 0
     data = result.to_json()
@@ -227,13 +227,13 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
 
 
 @pytest.mark.parametrize("name, finished, good_enough", [
-    ("bracket_plate", [8192], None), ("nist_ctc04_plate", [8192], None),
+    ("nist_ctc01_plate", [8192], None), ("nist_ctc04_plate", [8192], None),
     ("nist_ctc04_plate", [8192, 2048], 1.0)])
 def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_some(
         monkeypatch, name, finished, good_enough):
     # The freeing rounds and unstructured fills of a layout that leaves free faces cost
     # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
-    # it: bracket_plate's finer layout is all blocks, nist_ctc04_plate's 97.6 % of
+    # it: nist_ctc01_plate's finer layout is all blocks, nist_ctc04_plate's 97.5 % of
     # it (GOOD_ENOUGH); asked for all of it, the first layout is finished too.
     from quadcnn_wb.core import pipeline
 
@@ -267,7 +267,7 @@ def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_so
 def test_the_finer_background_is_skipped_when_it_would_not_fit_the_time_allowed():
     # The command line's --time-limit is a hard ceiling: a second layout that cannot fit
     # in it is not started (perforated_plate took 174 s with it, over the default 120 s).
-    domain = load_domain(CORPUS / PARTS["bracket_plate"]["file"])
+    domain = load_domain(CORPUS / PARTS["nist_ctc01_plate"]["file"])
     result = mesh_domain(domain, seconds=1e-3)
     assert result.structured_share < 1.0 and "other_background" not in result.timings
     assert result.reference.mesh.n_nodes < 2 * 2048  # the first background, not 4x it

@@ -262,3 +262,29 @@ def test_a_plate_with_small_convex_fillets_gets_the_sharp_plates_blocks():
     # expects two on a smooth curve: the hole's four valence-5 points and those four.
     assert got.quality["irregular_vertices"] == want.quality["irregular_vertices"] + 4
     assert got.quality["min_scaled_jacobian"] > 0.85
+
+
+def keyway_plate():
+    """A 20 × 10 plate with a slot 2 wide and 5 deep cut from its top edge, the slot's
+    end a half circle of radius 1 (a keyway, a crank web's slot)."""
+    return {"loops": [[{"line": [[0, 0], [20, 0]]}, {"line": [[20, 0], [20, 10]]},
+                       {"line": [[20, 10], [11, 10]]}, {"line": [[11, 10], [11, 5]]},
+                       {"arc": [[11, 5], [10, 4], [9, 5]]}, {"line": [[9, 5], [9, 10]]},
+                       {"line": [[9, 10], [0, 10]]}, {"line": [[0, 10], [0, 0]]}]]}
+
+
+def test_a_narrow_slots_round_end_is_one_corner_below_the_element_size():
+    # Radius 1 at element size 1.5: read as a curve, the half circle needed two valence-5
+    # points beside it, which the background cannot place within an element (AnalysisSitus
+    # 0031, a crankshaft web's keyway: a block turned back, 13 % of its quads unstructured);
+    # read as one corner (a slit's end), it needs none.  At size 0.4 it stays a curve.
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    domain = domain_from_json(keyway_plate())
+    (end,) = [f for f in boundary_features(domain, 1.5) if f.angle is not None]
+    assert end.angle > 1.5 * math.pi and end.pivot_segment == 4
+    result = mesh_domain(domain, size=1.5)
+    assert result.structured_share == 1.0
+    assert not result.reference.field.singularities
+    assert result.quality["irregular_vertices"] == result.feature_corners == 1
+    assert not [f for f in boundary_features(domain, 0.4) if f.angle is not None]

@@ -28,7 +28,13 @@ turn, or a curve's, is one feature with the sum of its turns:
   was split round an extra vertex (a rounded plate's corners came out as three squeezed
   quads each, worst scaled Jacobian 0.68 against 0.95 as corners); where a convex fillet
   is an element or more in radius, the field puts its valence-3 point in it instead;
-- a sharper convex feature (a narrow slot's round end) stays as its curves are.
+- a sharper convex feature (a narrow slot's round end) stays as its curves are;
+- a concave half circle of a radius under SLOT_END sizes (the end of a keyway or a slot
+  cut into the part, turning by more than ROUND_SWEEP) is one concave corner too, chained
+  with the turns beside it however long it is: read as a curve it needs two valence-5
+  points within an element of each other, which the background cannot place (a
+  crankshaft web's keyway: a block turned back by 104°, 13 % of its quads unstructured);
+  as a corner (a slit's end) it needs none.
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
 a chain of turns longer than MAX_SPAN sizes (a curve stored as a polyline: see below; one
 fillet's length is bounded by its radius rule), so a part with no such features is read
@@ -63,6 +69,8 @@ from .small_holes import is_quartered
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
 ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle stays a curve)
+SLOT_END = 1.0  # element sizes: ... unless its radius is under this (a narrow slot's end)
+SLOT_SWEEP = math.radians(200)  # ... turning at most this
 CONVEX_ROUND = 1.0  # element sizes: so is a convex fillet of a smaller radius
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
@@ -161,13 +169,14 @@ def _loop_features(li, loop, size) -> list:
     total = float(loop_offsets(loop)[-1])
     turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
              or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)
+             or _slot_end(loop, t, size)
              or (loop[t[2]].radius < CONVEX_ROUND * size and 0.0 < t[1] <= math.pi - CONVEX_MIN)]
     if not turns:
         return out
     gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
     # A fillet an element long or more is a feature on its own: the corner beside it
     # is one of the part's, not a detail of the fillet.
-    long = [t[5] - t[4] >= size for t in turns]
+    long = [t[5] - t[4] >= size and not _slot_end(loop, t, size) for t in turns]
     gaps = [reach if long[k] or long[(k + 1) % len(turns)] else gap
             for k, gap in enumerate(gaps)]
     if len(turns) > 1 and max(gaps) < reach:
@@ -184,6 +193,13 @@ def _loop_features(li, loop, size) -> list:
         if feature is not None:
             out.append(feature)
     return out
+
+
+def _slot_end(loop, turn, size) -> bool:
+    """Whether a turn is a narrow slot's round end: a concave arc of a radius under
+    SLOT_END sizes turning by more than ROUND_SWEEP, up to SLOT_SWEEP."""
+    return turn[3] == "curve" and loop[turn[2]].radius < SLOT_END * size \
+        and -SLOT_SWEEP <= turn[1] < -ROUND_SWEEP
 
 
 def _square_corners(li, loop) -> list:
