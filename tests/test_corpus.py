@@ -100,12 +100,14 @@ def test_the_irregular_vertices_are_the_fields_own(name):
 FINE_TOO_SLOW = {"perforated_plate"}
 # All in blocks there, with irregular vertices beyond the singular points and feature
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
-# against 12; gmsh alg. 11 has 387 and 144).
-FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19"}
+# against 12; gmsh alg. 11 has 387 and 144); crankshaft_web_keyway 90 % in blocks (its
+# bridge between keyway and hub; gmsh alg. 11's quads fold there).
+FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19", "crankshaft_web_keyway"}
 
 
 @pytest.mark.parametrize("name", [
-    expected_failure(n, FINE_EXTRA_IRREGULAR, "irregular vertices the field does not have")
+    expected_failure(n, FINE_EXTRA_IRREGULAR, "free faces or irregular vertices the field "
+                                              "does not have")
     for n in MESHABLE if n not in FINE_TOO_SLOW])
 def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
     from quadcnn_wb.core.input.pose import diameter
@@ -157,12 +159,14 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # (input.features; the gear's root fillets and engine_top's are concave corners at the
 # default size, and a mirrored copy must read each stretch the same way round);
 # nist_ctc01_plate and anc101_flange: bolt holes read as squares (input.small_holes),
-# whose corners a turned or mirrored copy must place alike.
+# whose corners a turned or mirrored copy must place alike; crankshaft_web_keyway and
+# bracket_plate: slot ends read as corners, placed alike in every pose.
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
                                   "motor_c_plate", "sketch_gear", "engine_top",
-                                  "nist_ctc01_plate", "anc101_flange"])
+                                  "nist_ctc01_plate", "anc101_flange",
+                                  "crankshaft_web_keyway", "bracket_plate"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 
