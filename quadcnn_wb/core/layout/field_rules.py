@@ -275,11 +275,17 @@ def _blended_tail(points, own, reach):
     from_end = cum[-1] - cum  # distance along the line to the point
     target = np.column_stack([np.interp(from_end, own_cum, own[:, 0]),
                               np.interp(from_end, own_cum, own[:, 1])])
-    x = np.clip(1.0 - from_end / reach, 0.0, 1.0)
-    w = (x * x * (3.0 - 2.0 * x))[:, None]
+    w = tail_weights(from_end, reach)[:, None]
     moved = (1.0 - w) * points + w * target
     moved[-1] = points[-1]
     return moved
+
+
+def tail_weights(from_end, reach) -> np.ndarray:
+    """How far each point of a line's last ``reach`` moves with its end: rising smoothly
+    (smoothstep) from 0 at ``reach`` to 1 at the end, by arc length ``from_end``."""
+    x = np.clip(1.0 - np.asarray(from_end, dtype=float) / reach, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
 
 
 def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:

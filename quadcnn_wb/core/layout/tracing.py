@@ -18,6 +18,7 @@ from ..field.background import BackgroundMesh
 from ..field.framefield import FrameField
 from ..input.curves import Arc
 from ..input.domain import Domain
+from .crossings import cumulative_length
 from .field_rules import (
     MAX_LENGTH,
     SNAP,
@@ -29,6 +30,7 @@ from .field_rules import (
     one_line_per_separatrix,
     separatrix_sources,
     snap_targets,
+    tail_weights,
 )
 from .streamlines import Endpoint, Streamline
 
@@ -227,14 +229,11 @@ def _shifted_tail(path, shift, reach) -> list:
     if not np.any(shift):
         return path
     points = np.asarray(path, dtype=float)
-    from_end = np.concatenate([np.cumsum(np.hypot(*np.diff(points[::-1], axis=0).T))[::-1],
-                               [0.0]])
-    reach = min(reach, 0.5 * float(from_end[0]))  # the start stays where it is
+    cum = cumulative_length(points)
+    reach = min(reach, 0.5 * float(cum[-1]))  # the start stays where it is
     if reach <= 0:
         return path
-    x = np.clip(1.0 - from_end / reach, 0.0, 1.0)
-    moved = points + (x * x * (3.0 - 2.0 * x))[:, None] * shift
-    return list(moved)
+    return list(points + tail_weights(cum[-1] - cum, reach)[:, None] * shift)
 
 
 def _segment_param(p0, p1, a, b) -> float:
