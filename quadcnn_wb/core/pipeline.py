@@ -293,6 +293,27 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     Jacobian a mesh must beat (lower only where the alternative is a folded mesh).
     ``stop_at_free``: raise LeavesFreeFaces as soon as the first partition has free faces."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
+    found = _rounds(domain, background, field, lines, size, smoothing, timings, allow_free,
+                    worst_allowed, stop_at_free, cut_hexagons=False)
+    if not allow_free or not any(HEXAGON in face.reason for face in found[1].free_faces):
+        return found
+    # Six-cornered faces that no rebuild made into blocks: cut in two (layout.subdivide),
+    # at the price of an irregular vertex at each end of the cut, where the faces' quads
+    # are unstructured otherwise.  Kept if the mesh is better (more in blocks, fair).
+    try:
+        cut = _rounds(domain, background, field, lines, size, smoothing, timings,
+                      allow_free, worst_allowed, stop_at_free, cut_hexagons=True)
+    except PartitionError:
+        return found
+    return cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
+
+
+HEXAGON = "has 6 corners"  # how partition names a six-cornered face
+
+
+def _rounds(domain, background, field, lines, size, smoothing, timings, allow_free,
+            worst_allowed, stop_at_free, cut_hexagons):
+    """blocks_and_mesh's partitions and rebuilds, with or without cutting hexagons."""
     dissolve, freed, unbalanced = frozenset(), set(), set()
     clock = time.perf_counter()
     cuts = connecting_cuts(domain, background, field, lines)  # the same in every round
@@ -300,7 +321,8 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
         partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
-                                    background.flat_joints, background.feature_corners)
+                                    background.flat_joints, background.feature_corners,
+                                    cut_hexagons)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")

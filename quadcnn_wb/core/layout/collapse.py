@@ -25,6 +25,8 @@ class NodeLayout:
     n_nodes: int
     boundary: np.ndarray  # raw node on the domain boundary
     anchor: np.ndarray  # raw node that may not share a place with another anchor
+    fixed: np.ndarray  # raw node at a boundary corner or a singular point
+    along_boundary: np.ndarray  # raw node -> smallest raw node joined by no-segment boundary arcs
 
 
 def node_layout(partition, counts) -> NodeLayout:
@@ -44,7 +46,21 @@ def node_layout(partition, counts) -> NodeLayout:
         boundary[np.concatenate(boundary_ids)] = True
     anchor = boundary.copy()
     anchor[list(partition.singular)] = True
-    return NodeLayout(edge_nodes, n, boundary, anchor)
+    fixed = np.zeros(n, dtype=bool)
+    fixed[list(partition.singular) + list(partition.fixed)] = True
+    along = np.arange(n)
+    for e, edge in enumerate(partition.edges):
+        if edge.is_boundary and int(counts[e]) == 0:
+            ra, rb = _root(along, edge.a), _root(along, edge.b)
+            along[max(ra, rb)] = min(ra, rb)
+    along = np.array([_root(along, x) for x in range(n)], dtype=np.int64)
+    return NodeLayout(edge_nodes, n, boundary, anchor, fixed, along)
+
+
+def _root(parent, x) -> int:
+    while parent[x] != x:
+        x = parent[x]
+    return int(x)
 
 
 def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
@@ -114,10 +130,17 @@ def conflicts(layout: NodeLayout, found: Merges) -> list:
         adjacency.setdefault(v, []).append((u, reason))
     for root in sorted(groups):
         anchors = groups[root]
-        if len(anchors) < 2:
+        if len(anchors) < 2 or _slid(layout, anchors):
             continue
         out.append(_path_reasons(adjacency, anchors[0], set(anchors[1:])))
     return out
+
+
+def _slid(layout: NodeLayout, anchors) -> bool:
+    """Anchors merged only along boundary arcs with no segments, at most one a corner."""
+    return (len({int(layout.along_boundary[x]) for x in anchors}) == 1
+            and all(layout.boundary[x] for x in anchors)
+            and sum(bool(layout.fixed[x]) for x in anchors) <= 1)
 
 
 def _path_reasons(adjacency, source, targets) -> list:

@@ -22,6 +22,8 @@ import math
 
 import numpy as np
 
+from ..input.corners import interior_angle
+from ..input.features import is_smooth_join
 from .crossings import crossings, end_places, point_at
 from .partition_types import (
     BoundaryPiece,
@@ -66,7 +68,7 @@ def _boundary_key(domain, loop: int, seg: int, t: float):
 
 def build_partition(domain, streamlines, element_size: float, cuts=(),
                     dissolve=frozenset(), flat_joints=frozenset(),
-                    feature_corners=frozenset()) -> Partition:
+                    feature_corners=frozenset(), cut_hexagons=False) -> Partition:
     """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py),
     less the streamline edges whose origin is in ``dissolve`` (faces merged where a free
     face could not be filled).  ``flat_joints``: (loop, segment) of the loop vertices in a
@@ -75,7 +77,9 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     ``feature_corners``: (loop, segment, parameter, angle) of such features' corners
     inside a curve (BackgroundMesh.feature_corners): vertices, as a loop's corners are,
     where a face turns by the feature's whole turn (its curve turns a little within the
-    reach that measures a face's turns elsewhere)."""
+    reach that measures a face's turns elsewhere).  ``cut_hexagons``: a six-cornered
+    face becomes two blocks (subdivide.py) instead of a free face; its cut's ends become
+    irregular vertices, so that is the last resort (pipeline.blocks_and_mesh)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -93,6 +97,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     for li, si, t, angle in sorted(feature_corners):
         boundary_splits[li].add(_boundary_key(domain, li, si, t)[2:])
         bends.append((domain.loops[li][si].point(t), math.pi - angle))
+    fixed_places = [place for place, _ in bends] + _loop_corners(domain, flat_joints)
     for k, (pts, (start, end)) in enumerate(zip(lines, ends)):
         # A singular point on the boundary itself (its separatrix there has no length) is
         # that boundary vertex, not a second vertex in the same place.
@@ -137,9 +142,11 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     turns = _vertex_turns(verts.xy, bends, tol)
     # Without the slivers' edges where that leaves no more free faces than with them
     # (where no sliver edge went, the two builds are one).
-    thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True)
+    corner_counts = (3, 4, 5, 6) if cut_hexagons else (3, 4, 5)
+    thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True, corner_counts)
     if thinned[4]:
-        kept = _faces_without_slits(verts.xy, edges, element_size, turns, False)
+        kept = _faces_without_slits(verts.xy, edges, element_size, turns, False,
+                                    corner_counts)
         thinned = kept if len(kept[2]) < len(thinned[2]) else thinned
     edges, faces, free, islands, _ = thinned
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
@@ -147,17 +154,43 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
     used = {v for edge in edges for v in (edge.a, edge.b)}
     singular = tuple(sorted(singular & used))
+    fixed = tuple(sorted(_at_places(vertices, fixed_places, tol) & used))
     return _used_vertices_only(Partition(vertices=np.array(vertices), edges=edges,
                                          blocks=blocks, cuts=list(cuts), singular=singular,
-                                         free_faces=free))
+                                         free_faces=free, fixed=fixed))
 
 
-def _faces_without_slits(xy, edges, h, turns, slivers: bool) -> tuple:
+def _loop_corners(domain, flat_joints) -> list:
+    """Places of the loop vertices where the boundary turns (no smooth joint, no joint
+    inside a feature read as flat)."""
+    out = []
+    for li, loop in enumerate(domain.loops):
+        for si, curve in enumerate(loop):
+            if curve.kind == "circle" or (li, si) in flat_joints:
+                continue
+            if not is_smooth_join(interior_angle(loop[si - 1], curve)):
+                out.append(curve.point(0.0))
+    return out
+
+
+def _at_places(vertices, places, tol) -> set:
+    """Ids of the vertices at any of the places (within tol)."""
+    if not places or not len(vertices):
+        return set()
+    xy = np.asarray(vertices, dtype=float)
+    out = set()
+    for place in places:
+        d = np.hypot(*(xy - place).T)
+        out.update(int(k) for k in np.nonzero(d <= tol)[0])
+    return out
+
+
+def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts) -> tuple:
     """(edges, faces, free faces, islands, whether a sliver edge went) once no slit,
     island outline (and, with ``slivers``, sliver edge) is left."""
     thinned = False
     while True:
-        faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns)
+        faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns, corner_counts)
         slits = _slits(free, edges) \
             | {e for island in islands for e, _ in island if not edges[e].is_boundary}
         if slivers:
@@ -183,7 +216,8 @@ def _used_vertices_only(partition: Partition) -> Partition:
               for block in partition.blocks]
     return dataclasses.replace(partition, vertices=partition.vertices[used], edges=edges,
                                blocks=blocks,
-                               singular=tuple(new[v] for v in partition.singular if v in new))
+                               singular=tuple(new[v] for v in partition.singular if v in new),
+                               fixed=tuple(new[v] for v in partition.fixed if v in new))
 
 
 def _one_vertex_per_place(edges, xy, h, singular) -> list:
@@ -592,7 +626,7 @@ def _vertex_turns(xy, bends, tol) -> dict:
     return out
 
 
-def _faces_to_blocks(vertices, edges, h, vertex_turns=None):
+def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4, 5)):
     reach = 0.5 * h
     half = []  # (edge id, forward)
     out_dirs: dict = {}
@@ -644,7 +678,8 @@ def _faces_to_blocks(vertices, edges, h, vertex_turns=None):
             islands.append(tuple(half[c] for c in cycle))  # the outside of an island
             continue
         try:
-            blocks.append(_block_of(cycle, half, edges, vertices, h, head, vertex_turns or {}))
+            blocks.append(_block_of(cycle, half, edges, vertices, h, head, vertex_turns or {},
+                                    corner_counts))
         except PartitionError as exc:
             places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
                       for c in cycle]
@@ -697,7 +732,7 @@ def _with_fourth_corner(turns, corner_at):
     return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
 
 
-def _block_of(cycle, half, edges, vertices, h, head, vertex_turns):
+def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts):
     reach = 0.5 * h
     turns = []
     for k, hid in enumerate(cycle):
@@ -728,7 +763,7 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns):
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
     if len(corner_at) == 3:
         corner_at = _with_fourth_corner(turns, corner_at)
-    if len(corner_at) not in (3, 4, 5):
+    if len(corner_at) not in corner_counts:
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
         raise PartitionError(f"a block near {fmt(centre)} has {len(corner_at)} corners "
                              f"instead of 4", outline, tips[corner_at])

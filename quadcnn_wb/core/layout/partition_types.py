@@ -91,6 +91,9 @@ class Partition:
     cuts: list  # extra polylines added so that every face is a disk
     singular: tuple = ()  # vertex ids of singular points: never merged with another anchor
     free_faces: list = field(default_factory=list)  # FreeFace: unstructured quads there
+    # Boundary vertex ids where the boundary has a corner (a loop's corner, a feature's):
+    # a boundary arc with no segments may not move one (quantize.py, collapse.py).
+    fixed: tuple = ()
 
     def edge_points(self, e: int, forward: bool) -> np.ndarray:
         pts = self.edges[e].points

@@ -2,13 +2,14 @@
 
 Opposite sides of every block must hold the same number of segments for a structured
 map; among all counts that satisfy this, take the one closest to length / target size in
-the sum of squared deviations.  Boundary arcs get at least one segment; streamline arcs
-may get none (Lyon, Campen, Kobbelt 2021; QuadWild's Bi-MDF): two separatrices that run
-side by side then become one mesh line and the strip between them vanishes (see
-collapse.py), where counts of at least one made the program infeasible or the strip a
-row of slivers.  A collapse may not put two anchors (boundary nodes, singular points) in
-one place; such a solution is refused by a row "one of the merges on the path between
-them does not happen" and the program solved again.
+the sum of squared deviations.  Boundary arcs get at least one segment, except short ones
+that do not join two corners (see collapse.py); streamline arcs may get none (Lyon,
+Campen, Kobbelt 2021; QuadWild's Bi-MDF): two separatrices that run side by side then
+become one mesh line and the strip between them vanishes (see collapse.py), where counts
+of at least one made the program infeasible or the strip a row of slivers.  A collapse
+may not put two anchors (boundary nodes, singular points) in one place; such a solution
+is refused by a row "one of the merges on the path between them does not happen" and the
+program solved again.
 
 Feasibility.  In a T-mesh traced exactly in the field's seamless parametrization the arc
 lengths in that parametrization are a positive real solution of the homogeneous equations;
@@ -86,6 +87,29 @@ def _rows(entries: list, n_columns: int):
     return matrix.tocsr()
 
 
+SHORT_BOUNDARY_ARC = 0.5  # element sizes: a boundary arc this short may get no segment
+MIN_LOOP_SEGMENTS = 3
+
+
+def _least_count(edge, size: float, fixed) -> int:
+    """0 for a streamline arc and for a short boundary arc that does not join two fixed
+    vertices (corners, singular points): its ends may become one mesh node (collapse.py),
+    as when the trace that made one of them had ended on the corner beside it; else 1."""
+    if not edge.is_boundary:
+        return 0
+    short = round(edge.length / size, 9) <= SHORT_BOUNDARY_ARC
+    return 0 if short and not (edge.a in fixed and edge.b in fixed) else 1
+
+
+def _loop_rings(partition: Partition, position) -> list:
+    """Variable positions of each boundary loop's edges."""
+    rings: dict = {}
+    for e, edge in enumerate(partition.edges):
+        if edge.is_boundary:
+            rings.setdefault(edge.pieces[0].loop, []).append(int(position[e]))
+    return [rings[li] for li in sorted(rings)]
+
+
 MAX_ROUNDS = 30  # conflict rows added one solve at a time
 MIN_FREE_FACE_HALVES = 3  # a free face's outline at half resolution: at least a triangle
 TIE_BREAK = 1e-6  # squared segments per segment, at most: orders equal-cost counts
@@ -158,7 +182,8 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
     # Rounded: a turned or rescaled copy must pose the very same problem (near-ties at
     # n + 0.5 would otherwise be broken by rounding noise).
     target = np.round(np.array([partition.edges[e].length / size for e in order]), 9)
-    lower = np.array([1 if partition.edges[e].is_boundary else 0 for e in order])
+    fixed = set(partition.fixed) | set(partition.singular)
+    lower = np.array([_least_count(partition.edges[e], size, fixed) for e in order])
     free_edges = sorted({int(position[e]) for face in partition.free_faces
                          for ring in face.rings for e, _ in ring})
     lower[free_edges] = 2
@@ -166,6 +191,9 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
     big = float(upper.max()) * (n_edges + 1)
     rows = []
     rows.extend(({v: 1, 2 * n_edges + v: -2}, 0, 0) for v in free_edges)
+    for ring in _loop_rings(partition, position):
+        if any(lower[v] == 0 for v in ring):  # no loop shrinks to fewer than 3 segments
+            rows.append((dict.fromkeys(ring, 1), MIN_LOOP_SEGMENTS, np.inf))
     for face in partition.free_faces:
         for ring in face.rings:  # a hole as well as the outline (a 2-point hole is none)
             row: dict = {}

@@ -11,6 +11,8 @@ price of a block-structured mesh there.  A face too concave for that stays a fre
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .partition_types import (
@@ -39,10 +41,28 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
     in ``unsplit`` (its blocks became a free face that could not be filled: the spokes
     are what a rebuild can take away) stays whole, a free face."""
     vertices = list(vertices)
-    odd = [f for f in faces if len(f[0]) != 4]
     blocks = []
     free_halves = [(list(f.halves), f.reason) for f in free]
     everything = list(faces) + [(None, [halves]) for halves, _ in free_halves]
+    # Six-cornered faces are cut between two opposite corners first (no centre, no new
+    # side middles): their cut is decided on the sides as they are now, which the other
+    # faces' splits only subdivide.
+    halved = []
+    for face in faces:
+        if len(face[0]) == 6:
+            corners, sides = face
+            key = split_key(vertices, corners)
+            at = None if key in unsplit else _opposite_corners(vertices, edges, corners, sides)
+            if at is None:
+                why = "whose split could not be filled" if key in unsplit \
+                    else "has no cut into two quadrilaterals"
+                centre = np.mean([vertices[c] for c in corners], axis=0)
+                halves = [h for side in sides for h in side]
+                free_halves.append((halves, f"a 6-cornered block near {fmt(centre)} {why}"))
+                everything.append((None, [halves]))
+            else:
+                halved.append((face, at, key))
+    odd = [f for f in faces if len(f[0]) not in (4, 6)]
     # Every side's middle first: a later face's split cuts an edge of an earlier face's
     # side too, and that face's blocks must be made from its sides as finally cut.
     all_mids = [[_split_side(vertices, edges, everything, sides, j, domain)
@@ -74,10 +94,83 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
             blocks.append(Block(corners=(corners[j], mids[j], c_id, mids[prev]),
                                 sides=(tuple(first_half), ((spokes[j], False),),
                                        ((spokes[prev], True),), tuple(second_half))))
+    for (corners, sides), at, key in halved:
+        blocks.extend(_halves_of_hexagon(vertices, edges, corners, sides, at, key))
     for corners, sides in faces:
         if len(corners) == 4:
             blocks.append(Block(corners=tuple(corners), sides=tuple(tuple(s) for s in sides)))
     return vertices, blocks, [FreeFace(tuple(h), reason) for h, reason in free_halves]
+
+
+MIN_CUT_ANGLE = np.radians(30.0)  # the least angle a hexagon's cut may leave at a corner
+
+
+def _opposite_corners(vertices, edges, corners, sides):
+    """Which corner k of a six-cornered face to join to corner k + 3 (None: no cut stays
+    inside the face with every angle it makes at least MIN_CUT_ANGLE).
+
+    Two blocks either side of one straight cut, where a midpoint split would put a
+    valence-6 vertex in the middle: the cut's ends get one more edge each, nothing else
+    changes.  The cut leaving the widest least angle wins; a tie (a symmetric face) goes
+    to the first corner of the cycle, which the face's own walk fixes, not the pose."""
+    outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
+    best, best_angle = None, MIN_CUT_ANGLE
+    for k in range(3):
+        a, b = np.asarray(vertices[corners[k]]), np.asarray(vertices[corners[k + 3]])
+        if not _inside(outline, a, b):
+            continue
+        angle = min(min(_split_angles(edges, sides, k, b - a)),
+                    min(_split_angles(edges, sides, k + 3, a - b)))
+        if angle > best_angle + 1e-9:
+            best, best_angle = k, angle
+    return best
+
+
+def _split_angles(edges, sides, k, cut) -> tuple:
+    """The two angles a cut along ``cut`` makes at corner k with the face's sides there
+    (counter-clockwise from the side leaving k, then on to the side arriving)."""
+    leaving = _side_points(sides[k], edges)
+    arriving = _side_points(sides[k - 1], edges)[::-1]
+    out = _heading(leaving)
+    back = _heading(arriving)
+    ccw = lambda u, v: (math.atan2(u[0] * v[1] - u[1] * v[0], u @ v)) % (2 * math.pi)  # noqa: E731
+    return ccw(out, cut), ccw(cut, back)
+
+
+def _heading(points) -> np.ndarray:
+    """Direction from a polyline's start towards the point a quarter of its length on."""
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    k = min(int(np.searchsorted(cum, cum[-1] / 4)), len(points) - 1)
+    return points[max(k, 1)] - points[0]
+
+
+def _inside(outline, a, b) -> bool:
+    """The segment a-b lies inside the closed outline: its middle inside, and no outline
+    segment away from its ends crosses it."""
+    if not inside_polygon(outline, (a + b) / 2):
+        return False
+    p, q = outline, np.roll(outline, -1, axis=0)
+    near_end = lambda x: np.minimum(np.hypot(*(x - a).T), np.hypot(*(x - b).T))  # noqa: E731
+    away = (near_end(p) > 1e-9 * np.hypot(*(b - a))) & (near_end(q) > 1e-9 * np.hypot(*(b - a)))
+    cross = lambda u, v, w: (v[..., 0] - u[..., 0]) * (w[..., 1] - u[..., 1]) \
+        - (v[..., 1] - u[..., 1]) * (w[..., 0] - u[..., 0])  # noqa: E731
+    d1, d2 = cross(a, b, p), cross(a, b, q)
+    d3, d4 = cross(p, q, a), cross(p, q, b)
+    hits = (d1 * d2 < 0) & (d3 * d4 < 0) & away
+    return not hits.any()
+
+
+def _halves_of_hexagon(vertices, edges, corners, sides, k, key) -> list:
+    """The two blocks of a six-cornered face cut from corner k to corner k + 3."""
+    a, b = corners[k], corners[k + 3]
+    cut = len(edges)
+    edges.append(Edge(points=np.linspace(vertices[a], vertices[b], 8), a=a, b=b, origin=key))
+    first = Block(corners=tuple(corners[k:k + 4]),
+                  sides=tuple(tuple(s) for s in sides[k:k + 3]) + (((cut, False),),))
+    rest = [corners[(k + 3 + j) % 6] for j in range(4)]
+    second = Block(corners=tuple(rest),
+                   sides=tuple(tuple(sides[(k + 3 + j) % 6]) for j in range(3)) + (((cut, True),),))
+    return [first, second]
 
 
 def _head(edges, half):

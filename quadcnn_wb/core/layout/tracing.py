@@ -57,6 +57,11 @@ class _BoundaryIndex:
             ids = mesh.boundary_nodes[mesh.boundary_loop == li]
             self.next[ids] = np.roll(ids, -1)
         self.corner_nodes = set(mesh.corner_nodes.tolist())
+        self.inner_corners: dict = {}  # (loop, segment) -> [(param, node)] of feature pivots
+        for node in self.corner_nodes:
+            if self.param[node] > 0.0:
+                key = (int(self.loop[node]), int(self.segment[node]))
+                self.inner_corners.setdefault(key, []).append((float(self.param[node]), node))
         self.vertex_node = {}
         for node in mesh.boundary_nodes[mesh.boundary_param == 0.0]:
             self.vertex_node[(int(self.loop[node]), int(self.segment[node]))] = int(node)
@@ -82,6 +87,14 @@ class _BoundaryIndex:
         if isinstance(curve, Arc) and curve.is_full:  # a circle's t = 0 is no vertex
             return Endpoint("boundary", -1, li, si, float(t)), curve.point(t)
         along = t * curve.length
+        # A feature's corner inside the curve (a small concave fillet read as one corner at
+        # its pivot) takes an end as close as a loop vertex would.
+        pivots = [(abs(tc - t) * curve.length, node, tc)
+                  for tc, node in self.inner_corners.get((li, si), ())]
+        if pivots:
+            gap, node, tc = min(pivots)
+            if gap <= CORNER_SNAP * element and gap < min(along, curve.length - along):
+                return Endpoint("corner", node, li, si, tc), curve.point(tc)
         if along <= CORNER_SNAP * element:
             t = 0.0
         elif curve.length - along <= CORNER_SNAP * element:

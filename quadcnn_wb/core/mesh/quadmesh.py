@@ -160,6 +160,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     boundary_ids = set(ids[layout.boundary].tolist())
     for x in np.nonzero(layout.boundary)[0]:
         positions[ids[x]] = raw[x]
+    _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions)
     quads, owner = [], []
     for b, block in enumerate(partition.blocks):
         if b in found.collapsed:
@@ -224,6 +225,28 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
                     edge_nodes=edge_nodes, free_face_of_quad=free_owner)
+
+
+def _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions) -> None:
+    """Boundary nodes merged along boundary arcs with no segments (collapse.py): on the
+    corner among them if there is one, else half-way along the longest such arc (so that
+    the place does not hang on which end came first)."""
+    zero = sorted((e for e, edge in enumerate(partition.edges)
+                   if edge.is_boundary and int(counts[e]) == 0),
+                  key=lambda e: -partition.edges[e].length)
+    if not zero:
+        return
+    placed = set()
+    for x in np.nonzero(layout.fixed & layout.boundary)[0]:
+        positions[ids[x]] = raw[x]
+        placed.add(int(ids[x]))
+    for e in zero:
+        node = int(ids[partition.edges[e].a])
+        if node in placed:
+            continue
+        chain = _EdgeChain(domain, partition.edges[e])
+        positions[node] = chain.point(0.5 * float(chain.start[-1]))
+        placed.add(node)
 
 
 class SquashedBlocks(PartitionError):

@@ -1,0 +1,90 @@
+"""What the T-mesh does with faces and arcs that are too small or too many-cornered for a
+block: a short boundary arc beside a trace's end takes no segment, so the strip it
+bounds collapses; a six-cornered face is cut in two between opposite corners."""
+
+from __future__ import annotations
+
+import numpy as np
+from shapes import polygon
+
+from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.layout.partition import build_partition
+from quadcnn_wb.core.layout.quantize import quantize
+from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+from quadcnn_wb.core.mesh.quadmesh import build_quad_mesh
+from quadcnn_wb.core.mesh.quality import scaled_jacobians
+
+
+def _rectangle():
+    return domain_from_json({"loops": [polygon([[0, 0], [10, 0], [10, 4], [0, 4]])]})
+
+
+def _vertical(x, upwards, top_segment=2, top_from=10.0):
+    """A field line across the 10 x 4 rectangle at x, ending on its bottom and on its
+    top (curve ``top_segment``, running from x = top_from to 0)."""
+    bottom = Endpoint("boundary", -1, 0, 0, x / 10)
+    top = Endpoint("boundary", -1, 0, top_segment, (top_from - x) / top_from)
+    ys = np.linspace(0, 4, 9) if upwards else np.linspace(4, 0, 9)
+    points = np.column_stack([np.full(9, float(x)), ys])
+    return Streamline(points, bottom, top) if upwards else Streamline(points, top, bottom)
+
+
+def test_a_strip_between_lines_a_fifth_of_an_element_apart_collapses_to_one_line():
+    # Two traces that reach the rim 0.2 sizes apart (a separatrix and a corner's line
+    # that ended just beside it): the rim between them may take no segment, so the
+    # strip they bound has no width and the two lines are one mesh line half-way
+    # between them.  Held to a segment, the strip was a column of slivers (or, beside
+    # a corner, left no counts at all).
+    domain = _rectangle()
+    lines = [_vertical(5.0, True), _vertical(5.2, False)]
+    partition = build_partition(domain, lines, 1.0)
+    assert len(partition.blocks) == 3
+    counts = quantize(partition, 1.0)
+    short = [e for e, edge in enumerate(partition.edges)
+             if edge.is_boundary and edge.length < 0.5]
+    assert len(short) == 2 and all(counts[e] == 0 for e in short)
+    mesh = build_quad_mesh(domain, partition, counts)
+    assert len(mesh.quads) == 40  # 10 columns of 4, no column for the strip
+    assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.9
+    on_rim = mesh.nodes[np.isclose(mesh.nodes[:, 1], 0.0)]
+    assert np.any(np.isclose(on_rim[:, 0], 5.1))  # half-way along the collapsed arc
+    assert not np.any(np.isclose(on_rim[:, 0], 5.0) | np.isclose(on_rim[:, 0], 5.2))
+
+
+def test_a_short_boundary_arc_between_two_corners_keeps_its_segment():
+    # A 0.28-long chamfer is as short, but both its ends are corners of the part: no
+    # collapse may move one of them.
+    domain = domain_from_json({"loops": [polygon([[0, 0], [10, 0], [10, 3.8], [9.8, 4],
+                                                  [0, 4]])]})
+    partition = build_partition(domain, [_vertical(5.0, True, 3, 9.8)], 1.0)
+    chamfer = [e for e, edge in enumerate(partition.edges)
+               if edge.is_boundary and edge.length < 0.5]
+    assert len(chamfer) == 1
+    edge = partition.edges[chamfer[0]]
+    assert edge.a in partition.fixed and edge.b in partition.fixed
+    assert quantize(partition, 1.0)[chamfer[0]] >= 1
+
+
+def _elongated_hexagon():
+    return domain_from_json({"loops": [polygon([[0, 0], [4, 0], [5, 1.5], [4, 3], [0, 3],
+                                                [-1, 1.5]])]})
+
+
+def test_a_six_cornered_face_is_a_free_face_unless_cuts_are_asked_for():
+    partition = build_partition(_elongated_hexagon(), [], 1.0)
+    assert not partition.blocks and len(partition.free_faces) == 1
+    assert "has 6 corners" in partition.free_faces[0].reason
+
+
+def test_a_six_cornered_face_is_cut_where_the_cut_leaves_the_widest_angles():
+    # Of the three cuts between opposite corners, the one across the middle leaves 56°
+    # either side at both its ends; the diagonals leave 37°.
+    domain = _elongated_hexagon()
+    partition = build_partition(domain, [], 1.0, cut_hexagons=True)
+    assert len(partition.blocks) == 2 and not partition.free_faces
+    inner = [edge for edge in partition.edges if not edge.is_boundary]
+    assert len(inner) == 1
+    ends = sorted(map(tuple, partition.vertices[[inner[0].a, inner[0].b]].round(9)))
+    assert ends == [(-1.0, 1.5), (5.0, 1.5)]
+    mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
+    assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.5
