@@ -261,3 +261,26 @@ def test_an_exit_moved_onto_a_corner_bends_in_smoothly():
     # A line shorter than twice the reach keeps its start where it is.
     short = np.array(_shifted_tail(path[:6], np.array([0.0, 0.2]), 1.5))
     assert np.allclose(short[0], [0.0, 0.0]) and np.allclose(short[-1], [0.5, 0.2])
+
+
+def test_an_end_beside_a_features_corner_inside_a_curve_ends_on_it():
+    # A keyway's round end below the element size is one corner at its middle node
+    # (input.features); a trace reaching the rim a little beside it ends on it, as one
+    # beside a loop's vertex does (held-out AnalysisSitus 0043: 114 -> 103 irregular).
+    from test_features import keyway_plate
+
+    from quadcnn_wb.core.field.background import background_mesh
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.tracing import CORNER_SNAP, _BoundaryIndex
+
+    domain = domain_from_json(keyway_plate())
+    mesh = background_mesh(domain, 2048, feature_size=1.5)
+    index = _BoundaryIndex(domain, mesh)
+    ((t, node),) = index.inner_corners[(0, 4)]
+    h = mesh.element_size
+    step = CORNER_SNAP * h / domain.loops[0][4].length  # the snap's reach, in parameter
+    near, xy = index.endpoint(0, 4, t + 0.5 * step, h)
+    assert (near.kind, near.index, near.param) == ("corner", node, t)
+    assert np.allclose(xy, mesh.nodes[node])
+    far, _ = index.endpoint(0, 4, t + 2 * step, h)
+    assert far.kind == "boundary" and far.param == pytest.approx(t + 2 * step)
