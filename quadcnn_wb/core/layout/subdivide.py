@@ -1,4 +1,4 @@
-"""Three- and five-cornered faces of a partition, split into quadrilateral blocks.
+"""Three-, five- and six-cornered faces of a partition, split into quadrilateral blocks.
 
 Near an acute corner (under 45°, a quarter-turn count of 0) or where singular points
 nearly coincide, a face of the streamline arrangement can come out with 3 or 5 corners.
@@ -6,7 +6,9 @@ Midpoint subdivision turns a k-cornered face into k blocks meeting at its centre
 side is cut at its middle (the neighbouring block just gets a T-junction there) and joined
 to the centre.  The centre becomes one extra irregular vertex (valence k), which is the
 price of a block-structured mesh there.  A face too concave for that stays a free face
-(unstructured quads, see free_faces.py).
+(unstructured quads, see free_faces.py).  A six-cornered face (when the partition is
+asked for it: the last resort, see partition.build_partition) is instead cut straight
+between two opposite corners into two blocks, an extra edge at each end of the cut.
 """
 
 from __future__ import annotations
@@ -111,8 +113,9 @@ def _opposite_corners(vertices, edges, corners, sides):
 
     Two blocks either side of one straight cut, where a midpoint split would put a
     valence-6 vertex in the middle: the cut's ends get one more edge each, nothing else
-    changes.  The cut leaving the widest least angle wins; a tie (a symmetric face) goes
-    to the first corner of the cycle, which the face's own walk fixes, not the pose."""
+    changes.  The cut leaving the widest least angle wins (a tie, in a symmetric face,
+    goes to the first of the face's corners).  A face's sides seen from a corner are
+    measured a quarter of their length on, so a kink at a corner does not decide."""
     outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
     best, best_angle = None, MIN_CUT_ANGLE
     for k in range(3):
@@ -133,8 +136,12 @@ def _split_angles(edges, sides, k, cut) -> tuple:
     arriving = _side_points(sides[k - 1], edges)[::-1]
     out = _heading(leaving)
     back = _heading(arriving)
-    ccw = lambda u, v: (math.atan2(u[0] * v[1] - u[1] * v[0], u @ v)) % (2 * math.pi)  # noqa: E731
-    return ccw(out, cut), ccw(cut, back)
+    return _ccw_angle(out, cut), _ccw_angle(cut, back)
+
+
+def _ccw_angle(u, v) -> float:
+    """Counter-clockwise angle from u to v, in [0, 2 pi)."""
+    return math.atan2(u[0] * v[1] - u[1] * v[0], float(u @ v)) % (2 * math.pi)
 
 
 def _heading(points) -> np.ndarray:
@@ -150,14 +157,22 @@ def _inside(outline, a, b) -> bool:
     if not inside_polygon(outline, (a + b) / 2):
         return False
     p, q = outline, np.roll(outline, -1, axis=0)
-    near_end = lambda x: np.minimum(np.hypot(*(x - a).T), np.hypot(*(x - b).T))  # noqa: E731
-    away = (near_end(p) > 1e-9 * np.hypot(*(b - a))) & (near_end(q) > 1e-9 * np.hypot(*(b - a)))
-    cross = lambda u, v, w: (v[..., 0] - u[..., 0]) * (w[..., 1] - u[..., 1]) \
-        - (v[..., 1] - u[..., 1]) * (w[..., 0] - u[..., 0])  # noqa: E731
-    d1, d2 = cross(a, b, p), cross(a, b, q)
-    d3, d4 = cross(p, q, a), cross(p, q, b)
+    tol = 1e-9 * np.hypot(*(b - a))
+    away = (_distance_to_ends(p, a, b) > tol) & (_distance_to_ends(q, a, b) > tol)
+    d1, d2 = _side_of(a, b, p), _side_of(a, b, q)
+    d3, d4 = _side_of(p, q, a), _side_of(p, q, b)
     hits = (d1 * d2 < 0) & (d3 * d4 < 0) & away
     return not hits.any()
+
+
+def _distance_to_ends(points, a, b) -> np.ndarray:
+    return np.minimum(np.hypot(*(points - a).T), np.hypot(*(points - b).T))
+
+
+def _side_of(u, v, w) -> np.ndarray:
+    """Twice the signed area of (u, v, w), row by row: which side of u-v w lies on."""
+    return (v[..., 0] - u[..., 0]) * (w[..., 1] - u[..., 1]) \
+        - (v[..., 1] - u[..., 1]) * (w[..., 0] - u[..., 0])
 
 
 def _halves_of_hexagon(vertices, edges, corners, sides, k, key) -> list:
