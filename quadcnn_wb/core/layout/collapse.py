@@ -118,8 +118,14 @@ def merges(partition, layout: NodeLayout, counts) -> Merges:
     return Merges(parent, links, collapsed)
 
 
-def conflicts(layout: NodeLayout, found: Merges) -> list:
-    """For every place where two anchors were merged, the merges on a path between them."""
+def conflicts(layout: NodeLayout, found: Merges, key=None) -> list:
+    """For every place where two anchors were merged, the merges on a path between them.
+
+    ``key`` (reason -> sortable, the same for a turned or mirrored copy of the part):
+    the path is the one a search in that order finds first from any of the anchors, and
+    of those the least by key, so that the program is refused the same merges in every
+    pose (raw node numbers and edge order are the pose's)."""
+    key = key or (lambda reason: reason)
     out = []
     groups: dict = {}
     for x in np.nonzero(layout.anchor)[0]:
@@ -128,11 +134,14 @@ def conflicts(layout: NodeLayout, found: Merges) -> list:
     for u, v, reason in found.links:
         adjacency.setdefault(u, []).append((v, reason))
         adjacency.setdefault(v, []).append((u, reason))
+    for neighbours in adjacency.values():
+        neighbours.sort(key=lambda item: key(item[1]))
     for root in sorted(groups):
         anchors = groups[root]
         if len(anchors) < 2 or _slid(layout, anchors):
             continue
-        out.append(_path_reasons(adjacency, anchors[0], set(anchors[1:])))
+        paths = [_path_reasons(adjacency, a, set(anchors) - {a}) for a in anchors]
+        out.append(min(paths, key=lambda reasons: sorted(key(r) for r in reasons)))
     return out
 
 
@@ -154,7 +163,7 @@ def _path_reasons(adjacency, source, targets) -> list:
             while came[x] is not None:
                 x, reason = came[x]
                 reasons.append(reason)
-            return sorted(set(reasons))
+            return list(set(reasons))
         for y, reason in adjacency.get(x, ()):
             if y not in came:
                 came[y] = (x, reason)

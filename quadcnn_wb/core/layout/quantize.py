@@ -28,6 +28,7 @@ the upper envelope of its secants through consecutive integers, exact at every i
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,6 +109,14 @@ def _loop_rings(partition: Partition, position) -> list:
         if edge.is_boundary:
             rings.setdefault(edge.pieces[0].loop, []).append(int(position[e]))
     return [rings[li] for li in sorted(rings)]
+
+
+def _merge_variables(partition: Partition, position, reason) -> tuple:
+    """The count variables (geometric positions) a merge (collapse.merges) hangs on."""
+    if reason[0] == "edge":
+        return (int(position[reason[1]]),)
+    _, b, pair = reason
+    return tuple(sorted({int(position[e]) for e, _ in partition.blocks[b].sides[pair]}))
 
 
 MAX_ROUNDS = 30  # conflict rows added one solve at a time
@@ -254,18 +263,11 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
         kept = [b for b in range(n_blocks) if b not in set(freed)]
         reduced = dataclasses.replace(partition, blocks=[partition.blocks[b] for b in kept])
         layout = node_layout(reduced, counts)
-        found = conflicts(layout, merges(reduced, layout, counts))
+        variables_of = functools.partial(_merge_variables, reduced, position)
+        found = conflicts(layout, merges(reduced, layout, counts), key=variables_of)
         if not found:
             return counts, freed
         for reasons in found:
-            variables = set()
-            for reason in reasons:
-                if reason[0] == "edge":
-                    variables.add(int(position[reason[1]]))
-                else:
-                    _, b, pair = reason
-                    variables.update(int(position[e]) for e, _ in
-                                     reduced.blocks[b].sides[pair])
-            forbidden.append(sorted(variables))
+            forbidden.append(sorted({v for reason in reasons for v in variables_of(reason)}))
     raise PartitionError("the segment counts keep pinching the domain (merging boundary "
                          "nodes or singular points)")
