@@ -293,16 +293,21 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     Jacobian a mesh must beat (lower only where the alternative is a folded mesh).
     ``stop_at_free``: raise LeavesFreeFaces as soon as the first partition has free faces."""
     timings["partition"] = timings["quantization"] = timings["quad_mesh"] = 0.0
-    found = _rounds(domain, background, field, lines, size, smoothing, timings, allow_free,
-                    worst_allowed, stop_at_free, cut_hexagons=False)
+    clock = time.perf_counter()
+    cuts = connecting_cuts(domain, background, field, lines)  # the same in every round
+    timings["partition"] += time.perf_counter() - clock
+    state = {"dissolve": frozenset(), "freed": set(), "unbalanced": set()}
+    found = _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
+                    worst_allowed, stop_at_free, False, state)
     if not allow_free or not any(HEXAGON in face.reason for face in found[1].free_faces):
         return found
     # Six-cornered faces that no rebuild made into blocks: cut in two (layout.subdivide),
     # at the price of an irregular vertex at each end of the cut, where the faces' quads
-    # are unstructured otherwise.  Kept if the mesh is better (more in blocks, fair).
+    # are unstructured otherwise.  Kept if the mesh is better (more in blocks, fair).  The
+    # rounds go on from where the first ones stopped (what they dissolved and gave up).
     try:
-        cut = _rounds(domain, background, field, lines, size, smoothing, timings,
-                      allow_free, worst_allowed, stop_at_free, cut_hexagons=True)
+        cut = _rounds(domain, background, lines, cuts, size, smoothing, timings,
+                      allow_free, worst_allowed, stop_at_free, True, state)
     except PartitionError:
         return found
     return cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
@@ -311,13 +316,11 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
 HEXAGON = "has 6 corners"  # how partition names a six-cornered face
 
 
-def _rounds(domain, background, field, lines, size, smoothing, timings, allow_free,
-            worst_allowed, stop_at_free, cut_hexagons):
-    """blocks_and_mesh's partitions and rebuilds, with or without cutting hexagons."""
-    dissolve, freed, unbalanced = frozenset(), set(), set()
-    clock = time.perf_counter()
-    cuts = connecting_cuts(domain, background, field, lines)  # the same in every round
-    timings["partition"] += time.perf_counter() - clock
+def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
+            worst_allowed, stop_at_free, cut_hexagons, state):
+    """blocks_and_mesh's partitions and rebuilds, with or without cutting hexagons;
+    ``state`` holds the edges dissolved and blocks given up so far, and is updated."""
+    dissolve, freed, unbalanced = state["dissolve"], set(state["freed"]), set(state["unbalanced"])
     for round_ in range(FREEING_ROUNDS + 1):
         clock = time.perf_counter()
         partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
@@ -376,6 +379,7 @@ def _rounds(domain, background, field, lines, size, smoothing, timings, allow_fr
             break
         freed |= folded
         dissolve = dissolve | merged
+    state.update(dissolve=dissolve, freed=freed, unbalanced=unbalanced)
     worst = sj.min() if len(sj) else 0.0
     if worst <= worst_allowed:
         if worst > 0.0 and tiles_exactly(mesh.nodes, mesh.quads) \
