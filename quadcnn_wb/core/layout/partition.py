@@ -33,6 +33,7 @@ from .partition_types import (
     PartitionError,
     fmt,
     inside_polygon,
+    pieces_length,
 )
 from .subdivide import split_odd_faces
 
@@ -521,7 +522,8 @@ def _boundary_edges(domain, li, positions, verts):
         polyline = np.vstack([pts[0]] + [q[1:] for q in pts[1:]])
         a = verts.get(_boundary_key(domain, li, seg, t), loop[seg].point(t))
         b = verts.get(_boundary_key(domain, li, nseg, nt), loop[nseg].point(nt))
-        edges.append(Edge(points=polyline, a=a, b=b, pieces=tuple(pieces)))
+        edges.append(Edge(points=polyline, a=a, b=b, pieces=tuple(pieces),
+                          exact_length=pieces_length(domain, pieces)))
     return edges
 
 

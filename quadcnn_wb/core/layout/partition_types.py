@@ -54,6 +54,11 @@ class Edge:
     pieces: tuple = ()  # BoundaryPiece stretches, in order, for boundary edges
     streamline: int = -1  # source streamline index for interior edges
     origin: tuple = ()  # (streamline, a, b) of the edge before any split: names it across rebuilds
+    # A boundary edge's length along its exact curves (pieces); -1 for a streamline edge.
+    # Its polyline's chords differ from it by up to 1e-5 of an element, and differently in
+    # a turned or mirrored copy (where the samples fall on a circle): enough to reorder
+    # near-equal arcs in the segment-count program (quantize.geometric_order).
+    exact_length: float = -1.0
 
     @property
     def is_boundary(self) -> bool:
@@ -61,7 +66,15 @@ class Edge:
 
     @property
     def length(self) -> float:
+        if self.exact_length >= 0.0:
+            return self.exact_length
         return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+def pieces_length(domain, pieces) -> float:
+    """Length of exact boundary stretches (BoundaryPiece) along their curves."""
+    return float(sum(domain.loops[p.loop][p.segment].length * abs(p.t1 - p.t0)
+                     for p in pieces))
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 from scipy.sparse import coo_matrix, lil_matrix
 
 from .collapse import conflicts, merges, node_layout
+from .crossings import cumulative_length, point_at
 from .partition_types import Partition, PartitionError
 
 
@@ -56,8 +57,11 @@ def geometric_order(partition: Partition, size: float) -> np.ndarray:
     centre = partition.vertices.mean(axis=0) if len(partition.vertices) else np.zeros(2)
     keys = []
     for e, edge in enumerate(partition.edges):
+        # The point half-way along (a mirrored copy samples its curves the other way
+        # round: the middle sample would be another point).
         pts = partition.edge_points(e, True)
-        middle = pts[len(pts) // 2]
+        cum = cumulative_length(pts)
+        middle = point_at(pts, cum, 0.5 * float(cum[-1]))
         keys.append((round(edge.length / size, 6),
                      round(float(np.hypot(*(middle - centre))) / size, 6)))
     return np.array(sorted(range(len(keys)), key=lambda e: keys[e]), dtype=np.int64)
@@ -115,8 +119,10 @@ def _merge_variables(partition: Partition, position, reason) -> tuple:
     """The count variables (geometric positions) a merge (collapse.merges) hangs on."""
     if reason[0] == "edge":
         return (int(position[reason[1]]),)
-    _, b, pair = reason
-    return tuple(sorted({int(position[e]) for e, _ in partition.blocks[b].sides[pair]}))
+    _, b, pair = reason  # both sides of the pair: which is side 0 depends on the pose
+    sides = partition.blocks[b].sides
+    return tuple(sorted({int(position[e]) for side in (sides[pair], sides[pair + 2])
+                         for e, _ in side}))
 
 
 MAX_ROUNDS = 30  # conflict rows added one solve at a time

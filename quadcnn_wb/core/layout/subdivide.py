@@ -25,6 +25,7 @@ from .partition_types import (
     PartitionError,
     fmt,
     inside_polygon,
+    pieces_length,
 )
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
@@ -259,10 +260,12 @@ def _split_edge(vertices, edges, e, s, domain):
     vertices.append(np.asarray(point, dtype=float))
     before = pts[cum < s]
     after = pts[cum > s]
+    exact = (pieces_length(domain, first), pieces_length(domain, second)) \
+        if edge.is_boundary else (-1.0, -1.0)
     edges[e] = Edge(points=np.vstack([before, point]), a=edge.a, b=v, pieces=first,
-                    streamline=edge.streamline, origin=edge.origin)
+                    streamline=edge.streamline, origin=edge.origin, exact_length=exact[0])
     edges.append(Edge(points=np.vstack([point, after]), a=v, b=edge.b, pieces=second,
-                      streamline=edge.streamline, origin=edge.origin))
+                      streamline=edge.streamline, origin=edge.origin, exact_length=exact[1]))
     return v, len(edges) - 1
 
 
