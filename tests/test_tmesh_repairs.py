@@ -5,6 +5,7 @@ bounds collapses; a six-cornered face is cut in two between opposite corners."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from shapes import polygon
 
 from quadcnn_wb.core.input.domain import domain_from_json
@@ -88,3 +89,22 @@ def test_a_six_cornered_face_is_cut_where_the_cut_leaves_the_widest_angles():
     assert ends == [(-1.0, 1.5), (5.0, 1.5)]
     mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
     assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.5
+
+
+def test_boundary_edges_are_measured_along_their_curves():
+    # Chords of the sampled arc are shorter by up to 1e-5 of an element, and by other
+    # amounts in a mirrored copy (whose samples run the other way round): enough to
+    # reorder near-equal arcs in the segment-count program's tie-break order.
+    import math
+
+    domain = domain_from_json({"loops": [[
+        {"line": [[0, 0], [10, 0]]}, {"line": [[10, 0], [10, 3]]},
+        {"arc": [[10, 3], [10 - 1 + math.cos(math.pi / 4), 3 + math.sin(math.pi / 4)],
+                 [9, 4]]},
+        {"line": [[9, 4], [0, 4]]}, {"line": [[0, 4], [0, 0]]}]]})
+    partition = build_partition(domain, [_vertical(5.0, True, 3, 9.0)], 1.0)
+    (arc,) = [edge for edge in partition.edges if edge.is_boundary
+              and any(domain.loops[0][p.segment].kind == "arc" for p in edge.pieces)]
+    chords = float(np.hypot(*np.diff(arc.points, axis=0).T).sum())
+    assert arc.length == pytest.approx(math.pi / 2, abs=1e-12)
+    assert chords < arc.length
