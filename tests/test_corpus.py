@@ -164,19 +164,19 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # default size, and a mirrored copy must read each stretch the same way round);
 # nist_ctc01_plate and anc101_flange: bolt holes read as squares (input.small_holes),
 # whose corners a turned or mirrored copy must place alike; crankshaft_web_keyway and
-# bracket_plate: slot ends read as corners, placed alike in every pose; grabcad_part19:
-# short boundary arcs with no segment (the merged node on the corner or half-way) and two
-# six-cornered faces cut in two.  (Not nist_ctc04_plate: all blocks in every pose, but
-# its mirror image gets 179 blocks and 361 quads against 177 and 381: the program's first
-# counts are the same, but where a collapse pinches, the search for the merges to refuse
-# meets equally short paths through different strips in another order.)
+# bracket_plate: slot ends read as corners, placed alike in every pose; grabcad_part19
+# and nist_ctc04_plate: short boundary arcs with no segment (the merged node on the
+# corner or half-way), on grabcad_part19 two six-cornered faces cut in two; nist_ctc04's
+# mirror image got other counts (177 blocks and 381 quads against 179 and 361) while
+# its edges were measured by chords and the merges refused to a pinch were found along
+# links in the pose's node order.
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
                                   "motor_c_plate", "sketch_gear", "engine_top",
                                   "nist_ctc01_plate", "anc101_flange",
                                   "crankshaft_web_keyway", "bracket_plate",
-                                  "grabcad_part19"])
+                                  "grabcad_part19", "nist_ctc04_plate"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

@@ -11,7 +11,6 @@ one of them (quantize.py) and the mesh builder never meets one.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,30 +118,64 @@ def merges(partition, layout: NodeLayout, counts) -> Merges:
 
 
 def conflicts(layout: NodeLayout, found: Merges, key=None) -> list:
-    """For every place where two anchors were merged, the merges on a path between them.
+    """For every place where two anchors were merged, merges that together pinch it: a
+    least set, found in the order of ``key``.
 
     ``key`` (reason -> sortable, the same for a turned or mirrored copy of the part):
-    the path is the one a search in that order finds first from any of the anchors, and
-    of those the least by key, so that the program is refused the same merges in every
-    pose (raw node numbers and edge order are the pose's)."""
+    reasons are taken in that order until anchors are merged, then dropped from the last
+    while they still are, so that the program is refused the same merges in every pose.
+    (A search along the links met equally short paths through different strips in the
+    order of the pose's raw node numbers: nist_ctc04_plate's mirror image got other
+    counts.)"""
     key = key or (lambda reason: reason)
     out = []
     groups: dict = {}
     for x in np.nonzero(layout.anchor)[0]:
         groups.setdefault(int(found.parent[x]), []).append(int(x))
-    adjacency: dict = {}
+    links_of: dict = {}
     for u, v, reason in found.links:
-        adjacency.setdefault(u, []).append((v, reason))
-        adjacency.setdefault(v, []).append((u, reason))
-    for neighbours in adjacency.values():
-        neighbours.sort(key=lambda item: key(item[1]))
+        links_of.setdefault(int(found.parent[u]), []).append((u, v, reason))
     for root in sorted(groups):
         anchors = groups[root]
         if len(anchors) < 2 or _slid(layout, anchors):
             continue
-        paths = [_path_reasons(adjacency, a, set(anchors) - {a}) for a in anchors]
-        out.append(min(paths, key=lambda reasons: sorted(key(r) for r in reasons)))
+        out.append(_least_reasons(layout, links_of.get(root, []), anchors, key))
     return out
+
+
+def _least_reasons(layout, links, anchors, key) -> list:
+    reasons = sorted({reason for _, _, reason in links}, key=key)
+    chosen = []
+    for reason in reasons:
+        chosen.append(reason)
+        if _pinches(layout, links, anchors, set(chosen)):
+            break
+    for reason in reversed(list(chosen)):
+        rest = set(chosen) - {reason}
+        if _pinches(layout, links, anchors, rest):
+            chosen.remove(reason)
+    return chosen
+
+
+def _pinches(layout, links, anchors, reasons) -> bool:
+    """Whether the links of these reasons alone put anchors together (other than a
+    slide along the boundary)."""
+    parent: dict = {}
+
+    def find(x):
+        parent.setdefault(x, x)
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for u, v, reason in links:
+        if reason in reasons:
+            parent[find(u)] = find(v)
+    together: dict = {}
+    for a in anchors:
+        together.setdefault(find(a), []).append(a)
+    return any(len(group) > 1 and not _slid(layout, group) for group in together.values())
 
 
 def _slid(layout: NodeLayout, anchors) -> bool:
@@ -150,22 +183,3 @@ def _slid(layout: NodeLayout, anchors) -> bool:
     return (len({int(layout.along_boundary[x]) for x in anchors}) == 1
             and all(layout.boundary[x] for x in anchors)
             and sum(bool(layout.fixed[x]) for x in anchors) <= 1)
-
-
-def _path_reasons(adjacency, source, targets) -> list:
-    """Reasons along a shortest merge path from source to any of targets."""
-    came = {source: None}
-    queue = deque([source])
-    while queue:
-        x = queue.popleft()
-        if x in targets:
-            reasons = []
-            while came[x] is not None:
-                x, reason = came[x]
-                reasons.append(reason)
-            return list(set(reasons))
-        for y, reason in adjacency.get(x, ()):
-            if y not in came:
-                came[y] = (x, reason)
-                queue.append(y)
-    return []
