@@ -83,9 +83,10 @@ def test_every_face_is_block_structured(name):
 # kite corners (layout.cusps), sketch_keyhole_plate's pair at the keyhole's foot,
 # grabcad_part19's two six-cornered faces beside its left bosses, each cut in two
 # (layout.subdivide: an irregular vertex at either end of the cut, where the faces had
-# unstructured quads before).
+# unstructured quads before), nist_ctc04_plate's valence-3 node beside the corner of a
+# bolt hole's square at (112, 752), where that corner gets 4 quads instead of 2.
 KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyhole_plate": 2,
-                         "grabcad_part19": 4}
+                         "grabcad_part19": 4, "nist_ctc04_plate": 1}
 
 
 @pytest.mark.parametrize("name", [n for n in MESHABLE if n not in PARTLY_BLOCKS])
