@@ -23,7 +23,7 @@ from .input.small_holes import squared_holes
 from .layout.cusps import with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
-from .layout.partition import build_partition
+from .layout.partition import build_partition, corners_instead_of_4
 from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
@@ -313,7 +313,7 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     return cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
 
 
-HEXAGON = "has 6 corners"  # how partition names a six-cornered face
+HEXAGON = corners_instead_of_4(6)  # in the reason of a six-cornered free face
 
 
 def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .components import Components
+
 
 @dataclass
 class NodeLayout:
@@ -25,7 +27,7 @@ class NodeLayout:
     boundary: np.ndarray  # raw node on the domain boundary
     anchor: np.ndarray  # raw node that may not share a place with another anchor
     fixed: np.ndarray  # raw node at a boundary corner or a singular point
-    along_boundary: np.ndarray  # raw node -> smallest raw node joined by no-segment boundary arcs
+    along_boundary: Components  # raw nodes joined by no-segment boundary arcs
 
 
 def node_layout(partition, counts) -> NodeLayout:
@@ -47,19 +49,11 @@ def node_layout(partition, counts) -> NodeLayout:
     anchor[list(partition.singular)] = True
     fixed = np.zeros(n, dtype=bool)
     fixed[list(partition.singular) + list(partition.fixed)] = True
-    along = np.arange(n)
+    along = Components()
     for e, edge in enumerate(partition.edges):
         if edge.is_boundary and int(counts[e]) == 0:
-            ra, rb = _root(along, edge.a), _root(along, edge.b)
-            along[max(ra, rb)] = min(ra, rb)
-    along = np.array([_root(along, x) for x in range(n)], dtype=np.int64)
+            along.union(int(edge.a), int(edge.b))
     return NodeLayout(edge_nodes, n, boundary, anchor, fixed, along)
-
-
-def _root(parent, x) -> int:
-    while parent[x] != x:
-        x = parent[x]
-    return int(x)
 
 
 def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
@@ -160,26 +154,18 @@ def _least_reasons(layout, links, anchors, key) -> list:
 def _pinches(layout, links, anchors, reasons) -> bool:
     """Whether the links of these reasons alone put anchors together (other than a
     slide along the boundary)."""
-    parent: dict = {}
-
-    def find(x):
-        parent.setdefault(x, x)
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
+    parts = Components()
     for u, v, reason in links:
         if reason in reasons:
-            parent[find(u)] = find(v)
+            parts.union(u, v)
     together: dict = {}
     for a in anchors:
-        together.setdefault(find(a), []).append(a)
+        together.setdefault(parts.find(a), []).append(a)
     return any(len(group) > 1 and not _slid(layout, group) for group in together.values())
 
 
 def _slid(layout: NodeLayout, anchors) -> bool:
     """Anchors merged only along boundary arcs with no segments, at most one a corner."""
-    return (len({int(layout.along_boundary[x]) for x in anchors}) == 1
+    return (len({layout.along_boundary.find(int(x)) for x in anchors}) == 1
             and all(layout.boundary[x] for x in anchors)
             and sum(bool(layout.fixed[x]) for x in anchors) <= 1)

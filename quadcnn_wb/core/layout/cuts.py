@@ -12,23 +12,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .components import Components
 from .streamlines import Endpoint
 from .tracing import integrate
-
-
-class _Components:
-    def __init__(self):
-        self.parent: dict = {}
-
-    def find(self, x):
-        self.parent.setdefault(x, x)
-        while self.parent[x] != x:
-            self.parent[x] = self.parent[self.parent[x]]
-            x = self.parent[x]
-        return x
-
-    def union(self, a, b):
-        self.parent[self.find(a)] = self.find(b)
 
 
 def _place(end: Endpoint, lines):
@@ -41,7 +27,7 @@ def _place(end: Endpoint, lines):
 
 def connecting_cuts(domain, mesh, field, streamlines) -> list:
     """Extra streamlines (start kind 'boundary') so that every loop joins loop 0."""
-    parts = _Components()
+    parts = Components()
     lines = list(streamlines)
     for k, line in enumerate(lines):
         parts.union(("line", k), _place(line.start, lines))

@@ -734,6 +734,12 @@ def _with_fourth_corner(turns, corner_at):
     return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
 
 
+def corners_instead_of_4(n: int) -> str:
+    """How a free face's reason names a face with n corners (pipeline.blocks_and_mesh
+    looks for six)."""
+    return f"has {n} corners instead of 4"
+
+
 def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts):
     reach = 0.5 * h
     turns = []
@@ -767,8 +773,8 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
         corner_at = _with_fourth_corner(turns, corner_at)
     if len(corner_at) not in corner_counts:
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
-        raise PartitionError(f"a block near {fmt(centre)} has {len(corner_at)} corners "
-                             f"instead of 4", outline, tips[corner_at])
+        raise PartitionError(f"a block near {fmt(centre)} {corners_instead_of_4(len(corner_at))}",
+                             outline, tips[corner_at])
     n_sides = len(corner_at)
     sides = []
     corners = []

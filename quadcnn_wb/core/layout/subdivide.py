@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from .crossings import cumulative_length, point_at
 from .partition_types import (
     Block,
     BoundaryPiece,
@@ -146,10 +147,9 @@ def _ccw_angle(u, v) -> float:
 
 
 def _heading(points) -> np.ndarray:
-    """Direction from a polyline's start towards the point a quarter of its length on."""
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
-    k = min(int(np.searchsorted(cum, cum[-1] / 4)), len(points) - 1)
-    return points[max(k, 1)] - points[0]
+    """Direction from a polyline's start to its point a quarter of its length on."""
+    cum = cumulative_length(points)
+    return point_at(points, cum, 0.25 * float(cum[-1])) - points[0]
 
 
 def _inside(outline, a, b) -> bool:
