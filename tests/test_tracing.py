@@ -250,16 +250,16 @@ def test_a_line_arrives_along_the_separatrix_it_heads_alike():
 
 
 def test_an_exit_moved_onto_a_corner_bends_in_smoothly():
-    from quadcnn_wb.core.layout.tracing import _shifted_tail
+    from quadcnn_wb.core.layout.field_rules import shifted_tail
 
     path = [np.array([x, 0.0]) for x in np.linspace(0.0, 3.0, 31)]
-    moved = np.array(_shifted_tail(path, np.array([0.0, 0.2]), 1.5))
+    moved = np.array(shifted_tail(path, np.array([0.0, 0.2]), 1.5))
     assert np.allclose(moved[-1], [3.0, 0.2]) and np.allclose(moved[:16], np.array(path)[:16])
     # No kink: the last step turns by less than a tenth of the shift's angle at one step.
     step = moved[-1] - moved[-2]
     assert abs(np.degrees(np.arctan2(step[1], step[0]))) < 15
     # A line shorter than twice the reach keeps its start where it is.
-    short = np.array(_shifted_tail(path[:6], np.array([0.0, 0.2]), 1.5))
+    short = np.array(shifted_tail(path[:6], np.array([0.0, 0.2]), 1.5))
     assert np.allclose(short[0], [0.0, 0.0]) and np.allclose(short[-1], [0.5, 0.2])
 
 

@@ -27,6 +27,7 @@ from .layout.partition import build_partition, corners_instead_of_4
 from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
+from .layout.wedges import without_corner_wedges
 from .mesh.gmsh_quads import gmsh_quad_mesh
 from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
 from .mesh.quality import mesh_quality, structured_share
@@ -272,9 +273,11 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
 
 
 def _t_mesh(domain, background, field, lines, size) -> tuple:
-    """Traces cut where they first meet an earlier one (see layout.motorcycle), and a
-    kite at each cusp's tip (layout.cusps)."""
+    """Traces cut where they first meet an earlier one (see layout.motorcycle), none in a
+    sliver wedge at a corner (layout.wedges), and a kite at each cusp's tip
+    (layout.cusps)."""
     lines = stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
+    lines = without_corner_wedges(domain, background, lines, size)
     return with_cusp_kites(domain, background, field, lines, size)
 
 

@@ -288,6 +288,26 @@ def tail_weights(from_end, reach) -> np.ndarray:
     return x * x * (3.0 - 2.0 * x)
 
 
+def shifted_tail(path, shift, reach) -> list:
+    """The path with its end moved by ``shift`` and the stretch before it by less and
+    less, to nothing ``reach`` back along it.
+
+    An exit moved onto a nearby corner (CORNER_SNAP) by its last point alone came in
+    with a kink of up to a right angle, and the faces either side measured their turn
+    at the corner from the kink: one lost its corner there (a T-slot's 225° notch: a
+    three-cornered face, split round an extra irregular vertex).  Weights are a smooth
+    function of arc length to the end, so a turned copy gets the same line; the reach is
+    at most half the line, whose start stays where it is."""
+    if not np.any(shift):
+        return path
+    points = np.asarray(path, dtype=float)
+    cum = cumulative_length(points)
+    reach = min(reach, 0.5 * float(cum[-1]))  # the start stays where it is
+    if reach <= 0:
+        return path
+    return list(points + tail_weights(cum[-1] - cum, reach)[:, None] * shift)
+
+
 def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
     """End ``line`` on ``other`` where it first comes within MERGE sizes of it."""
     dense = _densify(other.points, 0.25 * h)

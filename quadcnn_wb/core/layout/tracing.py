@@ -18,7 +18,6 @@ from ..field.background import BackgroundMesh
 from ..field.framefield import FrameField
 from ..input.curves import Arc
 from ..input.domain import Domain
-from .crossings import cumulative_length
 from .field_rules import (
     MAX_LENGTH,
     SNAP,
@@ -29,8 +28,8 @@ from .field_rules import (
     nearest_arm,
     one_line_per_separatrix,
     separatrix_sources,
+    shifted_tail,
     snap_targets,
-    tail_weights,
 )
 from .streamlines import Endpoint, Streamline
 
@@ -224,29 +223,9 @@ def _finish_exits(active, tri, exit_edge, old, pos, paths, ends, mesh, boundary,
         end, xy = boundary.endpoint(int(li), int(si), float(par), h)
         exact = boundary.domain.loops[int(li)][int(si)].point(float(par))
         paths[i][-1] = exact
-        paths[i] = _shifted_tail(paths[i], xy - exact, SNAP_BLEND * h)
+        paths[i] = shifted_tail(paths[i], xy - exact, SNAP_BLEND * h)
         ends[i] = end
     return np.array(keep, dtype=np.int64)
-
-
-def _shifted_tail(path, shift, reach) -> list:
-    """The path with its end moved by ``shift`` and the stretch before it by less and
-    less, to nothing ``reach`` back along it.
-
-    An exit moved onto a nearby corner (CORNER_SNAP) by its last point alone came in
-    with a kink of up to a right angle, and the faces either side measured their turn
-    at the corner from the kink: one lost its corner there (a T-slot's 225° notch: a
-    three-cornered face, split round an extra irregular vertex).  Weights are a smooth
-    function of arc length to the end, so a turned copy gets the same line; the reach is
-    at most half the line, whose start stays where it is."""
-    if not np.any(shift):
-        return path
-    points = np.asarray(path, dtype=float)
-    cum = cumulative_length(points)
-    reach = min(reach, 0.5 * float(cum[-1]))  # the start stays where it is
-    if reach <= 0:
-        return path
-    return list(points + tail_weights(cum[-1] - cum, reach)[:, None] * shift)
 
 
 def _segment_param(p0, p1, a, b) -> float:
