@@ -84,9 +84,13 @@ def test_every_face_is_block_structured(name):
 # grabcad_part19's two six-cornered faces beside its left bosses, each cut in two
 # (layout.subdivide: an irregular vertex at either end of the cut, where the faces had
 # unstructured quads before), nist_ctc04_plate's valence-3 node beside the corner of a
-# bolt hole's square at (112, 752), where that corner gets 4 quads instead of 2.
+# bolt hole's square at (112, 752), where that corner gets 4 quads instead of 2;
+# crankshaft_web_keyway's valence-3 and valence-5 vertices in the hub's two side bays
+# (its 2048-node layout, all blocks since layout.wedges: worst scaled Jacobian 0.84
+# against the finer layout's 0.71, which had none).
 KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyhole_plate": 2,
-                         "grabcad_part19": 4, "nist_ctc04_plate": 1}
+                         "grabcad_part19": 4, "nist_ctc04_plate": 1,
+                         "crankshaft_web_keyway": 2}
 
 
 @pytest.mark.parametrize("name", [n for n in MESHABLE if n not in PARTLY_BLOCKS])
@@ -105,8 +109,9 @@ def test_the_irregular_vertices_are_the_fields_own(name):
 FINE_TOO_SLOW = {"perforated_plate"}
 # All in blocks there, with irregular vertices beyond the singular points and feature
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
-# against 12; gmsh alg. 11 has 387 and 144); crankshaft_web_keyway 90 % in blocks (its
-# bridge between keyway and hub; gmsh alg. 11's quads fold there).
+# against 12; gmsh alg. 11 has 387 and 144); crankshaft_web_keyway 98.5 % in blocks (a strip
+# beside a slot's rounded corner, where two feature corners and a singular point lie
+# within an element; gmsh alg. 11's quads fold on this part).
 FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19", "crankshaft_web_keyway"}
 
 
@@ -247,16 +252,16 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
 
 @pytest.mark.parametrize("name, divisor, finished, good_enough", [
     ("nist_ctc01_plate", None, [8192], None),
-    ("crankshaft_web_keyway", 60, [8192, 2048], None),
-    ("crankshaft_web_keyway", 60, [8192], (0.85, 0.1))])
+    ("crankshaft_web_keyway", 100, [8192, 2048], None),
+    ("crankshaft_web_keyway", 100, [8192], (0.85, 0.05))])
 def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_some(
         monkeypatch, name, divisor, finished, good_enough):
     # The freeing rounds and unstructured fills of a layout that leaves free faces cost
     # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
     # it: nist_ctc01_plate's finer layout is all blocks; crankshaft_web_keyway's at
-    # diameter / 60 is 90 % blocks (its bridge; worst element 0.17), under GOOD_ENOUGH
-    # and FAIR_JACOBIAN, so the first layout is finished too, unless that is called good
-    # enough.
+    # diameter / 100 is 89 % blocks (worst element 0.095), under GOOD_ENOUGH and
+    # FAIR_JACOBIAN, so the first layout is finished too (and kept: 98.5 %), unless that
+    # is called good enough.
     from quadcnn_wb.core import pipeline
     from quadcnn_wb.core.input.pose import diameter
 

@@ -284,3 +284,24 @@ def test_an_end_beside_a_features_corner_inside_a_curve_ends_on_it():
     assert np.allclose(xy, mesh.nodes[node])
     far, _ = index.endpoint(0, 4, t + 2 * step, h)
     assert far.kind == "boundary" and far.param == pytest.approx(t + 2 * step)
+
+
+def test_a_second_line_onto_a_taken_separatrix_is_not_joined_where_both_leave_one_point():
+    # Two lines of one singular point whose far ends claim the same separatrix: the one
+    # that stays joins the other where it first comes near it, but not in the stretch
+    # where both still leave their shared point (joined there, crankshaft_web_keyway's
+    # keyway point lost its third separatrix to a line of no length).
+    from quadcnn_wb.core.layout.field_rules import _join
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    t = np.linspace(0.0, 1.0, 81)
+    taken = Streamline(np.column_stack([10.0 * t, 0.0 * t]),
+                       Endpoint("singularity", 5, branch=2),
+                       Endpoint("singularity", 8, branch=1))
+    bow = Streamline(np.column_stack([10.0 - 10.0 * t, 4.0 * np.sin(np.pi * t)]),
+                     Endpoint("singularity", 8, branch=0),
+                     Endpoint("singularity", 5, branch=2))
+    joined = _join(bow, taken, 0, 1.0)
+    assert (joined.end.kind, joined.end.index) == ("streamline", 0)
+    assert joined.length > 8.0  # most of its bow, not its first step
+    assert joined.points[-1][0] < 2.0  # near the far point, where it comes back to the line

@@ -309,10 +309,20 @@ def shifted_tail(path, shift, reach) -> list:
 
 
 def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:
-    """End ``line`` on ``other`` where it first comes within MERGE sizes of it."""
+    """End ``line`` on ``other`` where it first comes within MERGE sizes of it.  Where
+    both leave or reach one point (a singular point's two separatrices that end on the
+    same slot), not in the stretch where it is still leaving that point: joined there,
+    it kept no length and its separatrix was lost (crankshaft_web_keyway's keyway: a
+    valence-3 point with two lines, the face beside it turning back)."""
     dense = _densify(other.points, 0.25 * h)
     dist = cKDTree(dense).query(line.points)[0]
-    close = np.nonzero(dist <= MERGE * h)[0]
+    near = dist <= MERGE * h
+    if line.start.same_place(other.start) or line.start.same_place(other.end):
+        away = np.nonzero(~near)[0]
+        if not len(away):
+            return line
+        near[:away[0]] = False
+    close = np.nonzero(near)[0]
     close = close[close > 0]
     if not len(close):
         return line

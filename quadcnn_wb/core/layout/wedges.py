@@ -79,6 +79,8 @@ def _heading(line, which: int, reach: float) -> np.ndarray:
 def _wedge_moves(domain, background, lines, node, size, h) -> list:
     """(line, corner line it moves onto, arc length along that line from the corner)."""
     corner = corner_endpoint(background, node)
+    if node in background.feature_corners or corner.param not in (0.0, 1.0):
+        return []  # a feature read as a corner at the mesh's scale: its sides are no curves'
     loop = domain.loops[corner.loop]
     si, t = corner.segment, corner.param
     before = loop[(si - 1) % len(loop)] if t <= 0.0 else loop[si]
