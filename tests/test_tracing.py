@@ -305,3 +305,25 @@ def test_a_second_line_onto_a_taken_separatrix_is_not_joined_where_both_leave_on
     assert (joined.end.kind, joined.end.index) == ("streamline", 0)
     assert joined.length > 8.0  # most of its bow, not its first step
     assert joined.points[-1][0] < 2.0  # near the far point, where it comes back to the line
+
+
+def test_a_separatrix_passing_the_point_whose_trace_came_to_its_own_ends_there():
+    # Traced from q, a separatrix snapped onto p; traced from p, the same separatrix
+    # passed q two sizes away (beyond the snap radius) and ran on to the rim, shorter
+    # than the bowed trace from q, so it claimed p's slot first and the trace from q
+    # was joined onto it near p: two lines side by side and a strip between them that
+    # was no block.  Ended on q where it passes it, it is the one line between them.
+    from quadcnn_wb.core.layout.field_rules import one_line_per_separatrix
+    from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+    t = np.linspace(0.0, 1.0, 121)
+    from_p = Streamline(np.column_stack([11.0 * t, -2.2 * t]),
+                        Endpoint("singularity", 0, branch=0),
+                        Endpoint("boundary", -1, 0, 0, 0.5))
+    from_q = Streamline(np.column_stack([10.0 - 10.0 * t, 3.0 * np.sin(np.pi * t)]),
+                        Endpoint("singularity", 1, branch=1),
+                        Endpoint("singularity", 0, branch=0))
+    assert from_p.length < from_q.length
+    (line,) = one_line_per_separatrix([from_p, from_q], 1.0)
+    assert {(line.start.kind, line.start.index), (line.end.kind, line.end.index)} == \
+        {("singularity", 0), ("singularity", 1)}
