@@ -20,7 +20,7 @@ from .input.domain import Domain
 from .input.features import boundary_features
 from .input.pose import default_size
 from .input.small_holes import squared_holes
-from .layout.cusps import with_cusp_kites
+from .layout.cusps import tip_quads, with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import build_partition, corners_instead_of_4
@@ -370,7 +370,9 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
             continue
         timings["quad_mesh"] += time.perf_counter() - clock
         sj = scaled_jacobians(mesh.nodes, mesh.quads)
-        bad = sj <= MIN_VALID_JACOBIAN
+        # A quad at a cusp's tip is as good as the tip lets it be: it need only not fold.
+        tip = tip_quads(background, mesh.nodes, mesh.quads, size)
+        bad = sj <= np.where(tip, 0.0, MIN_VALID_JACOBIAN)
         if not tiles_exactly(mesh.nodes, mesh.quads):
             bad |= crossing_quads(mesh.nodes, mesh.quads)  # blocks folded over others
         folded = {_block_key(partition, int(b)) for b in mesh.block_of_quad[bad] if b >= 0}
@@ -383,7 +385,12 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
         freed |= folded
         dissolve = dissolve | merged
     state.update(dissolve=dissolve, freed=freed, unbalanced=unbalanced)
-    worst = sj.min() if len(sj) else 0.0
+    if not len(sj):
+        worst = 0.0
+    elif (sj[tip] <= 0.0).any():
+        worst = float(sj[tip].min())  # folded at a cusp's tip
+    else:
+        worst = float(sj[~tip].min(initial=1.0))  # tip quads: as good as their tips allow
     if worst <= worst_allowed:
         if worst > 0.0 and tiles_exactly(mesh.nodes, mesh.quads) \
                 and free_edges_on_boundary(mesh.quads, mesh.boundary) \

@@ -63,6 +63,29 @@ def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
     return tuple(lines)
 
 
+TIP_MATCH = 1e-6  # element sizes: a mesh node this close to a cusp's tip is its node
+
+
+def tip_quads(background, nodes, quads, size: float) -> np.ndarray:
+    """Per quad: whether one of its corners is a cusp's tip.
+
+    No quad at a tip can be better than the tip's angle lets it be: between tangent
+    curves that is the angle their chords of one element make, a few degrees, so a
+    scaled Jacobian under the pipeline's floor there says nothing about the layout
+    (a square with a tangent horn at diameter/100: 0.034 at the tip, and the whole face
+    went to gmsh's quads, 0.016 at the same tip)."""
+    tips = [background.nodes[int(n)] for n, a in zip(background.corner_nodes,
+                                                     background.corner_angles)
+            if a < SHARP_LOW]
+    out = np.zeros(len(quads), dtype=bool)
+    if not tips or not len(nodes):
+        return out
+    gap = np.hypot(nodes[:, None, 0] - np.array(tips)[None, :, 0],
+                   nodes[:, None, 1] - np.array(tips)[None, :, 1]).min(axis=1)
+    at_tip = gap <= TIP_MATCH * size
+    return at_tip[quads].any(axis=1)
+
+
 def _lines_at(lines, node) -> list:
     """(line, 0 for its start or 1 for its end) of the lines that end at a corner node."""
     return [(k, which) for k, line in enumerate(lines)

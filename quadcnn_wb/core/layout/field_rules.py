@@ -212,8 +212,13 @@ def _ended_on_passed_points(lines, h):
                 passes.append((hit[0], hit[1], j))
         if passes:
             cut, _, j = min(passes)  # the first point it passes
+            # Bent onto the point over its last stretch, not kinked at the nearest pass.
+            point = lines[j].points[0]
+            kept = np.asarray(shifted_tail(line.points[:cut + 1], point - line.points[cut],
+                                           ARRIVAL_BLEND * h), dtype=float)
+            kept[-1] = point
             out[k] = dataclasses.replace(
-                line, points=np.vstack([line.points[:cut], lines[j].points[0]]),
+                line, points=kept,
                 end=Endpoint("singularity", lines[j].start.index, branch=lines[j].start.branch))
     return out
 
