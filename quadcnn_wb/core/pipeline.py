@@ -302,21 +302,52 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     state = {"dissolve": frozenset(), "freed": set(), "unbalanced": set()}
     found = _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
                     worst_allowed, stop_at_free, False, state)
-    if not allow_free or not any(HEXAGON in face.reason for face in found[1].free_faces):
+    if not allow_free:
         return found
-    # Six-cornered faces that no rebuild made into blocks: cut in two (layout.subdivide),
-    # at the price of an irregular vertex at each end of the cut, where the faces' quads
-    # are unstructured otherwise.  Kept if the mesh is better (more in blocks, fair).  The
-    # rounds go on from where the first ones stopped (what they dissolved and gave up).
+    if any(HEXAGON in face.reason for face in found[1].free_faces):
+        # Six-cornered faces that no rebuild made into blocks: cut in two
+        # (layout.subdivide), at the price of an irregular vertex at each end of the
+        # cut, where the faces' quads are unstructured otherwise.  Kept if the mesh is
+        # better (more in blocks, fair).  The rounds go on from where the first ones
+        # stopped (what they dissolved and gave up).
+        try:
+            cut = _rounds(domain, background, lines, cuts, size, smoothing, timings,
+                          allow_free, worst_allowed, stop_at_free, True, state)
+            found = cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
+        except PartitionError:
+            pass
+    lens = _lens_lines(found[1]) - state["dissolve"]
+    if not lens:
+        return found
+    # Two-cornered faces between a line and the rim (a line from a hole's corner that
+    # hugs the hole's side to the next corner): the line goes, and the face with it.
+    # Kept if the mesh is better.
+    state = dict(state, dissolve=state["dissolve"] | lens)
     try:
-        cut = _rounds(domain, background, lines, cuts, size, smoothing, timings,
-                      allow_free, worst_allowed, stop_at_free, True, state)
+        merged = _rounds(domain, background, lines, cuts, size, smoothing, timings,
+                         allow_free, worst_allowed, stop_at_free,
+                         any(HEXAGON in f.reason for f in found[1].free_faces), state)
     except PartitionError:
         return found
-    return cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
+    return merged if _mesh_key(merged[3]) > _mesh_key(found[3]) else found
 
 
 HEXAGON = corners_instead_of_4(6)  # in the reason of a six-cornered free face
+LENS = corners_instead_of_4(2)  # ... and of a two-cornered one
+
+
+def _lens_lines(partition: Partition) -> frozenset:
+    """The longest streamline edge round each of the partition's two-cornered free faces
+    that touch the boundary (a lens between two lines is left as it is)."""
+    out = set()
+    for face in partition.free_faces:
+        if LENS not in face.reason:
+            continue
+        ring = [partition.edges[e] for loop in face.rings for e, _ in loop]
+        inner = [edge for edge in ring if not edge.is_boundary]
+        if inner and len(inner) < len(ring):
+            out.add(max(inner, key=lambda edge: (edge.length, edge.origin)).origin)
+    return frozenset(out)
 
 
 def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
