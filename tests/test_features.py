@@ -288,3 +288,31 @@ def test_a_narrow_slots_round_end_is_one_corner_below_the_element_size():
     assert not result.reference.field.singularities
     assert result.quality["irregular_vertices"] == result.feature_corners == 1
     assert not [f for f in boundary_features(domain, 0.4) if f.angle is not None]
+
+
+def test_a_fillet_stored_as_two_arcs_is_one_corner():
+    # The L's concave corner rounded by two tangent 45° arcs of radius 1.6 and 1.75 sizes,
+    # each longer than a size (a crank web's rounded slot corner at diameter/100): a
+    # fillet an element long is a feature on its own, but not apart from its other half,
+    # or the corner was two 225° corners an element apart, each with its own streamlines.
+    size = 1.2  # the arcs are longer than it, and the two together under MAX_SPAN sizes
+    r1, r2 = 1.9, 2.1
+    c1 = np.array([5 + r1, 5 + r1])
+    joint = c1 - r1 * np.array([math.cos(math.pi / 4), math.sin(math.pi / 4)])
+    c2 = joint + (c1 - joint) * (r2 / r1)  # tangent there: the same normal
+
+    def on(c, r, degrees):
+        a = math.radians(degrees)
+        return (c - r * np.array([math.cos(a), math.sin(a)])).tolist()
+
+    end = on(c2, r2, 0)
+    loops = [[{"line": [[0, 0], [20, 0]]}, {"line": [[20, 0], [20, 5]]},
+              {"line": [[20, 5], on(c1, r1, 90)]},
+              {"arc": [on(c1, r1, 90), on(c1, r1, 67.5), joint.tolist()]},
+              {"arc": [joint.tolist(), on(c2, r2, 22.5), end]},
+              {"line": [end, [end[0], 20]]}, {"line": [[end[0], 20], [0, 20]]},
+              {"line": [[0, 20], [0, 0]]}]]
+    features = boundary_features(domain_from_json({"loops": loops}), size)
+    corners = [f for f in features if f.angle is not None]
+    assert len(corners) == 1 and round(math.degrees(corners[0].angle), 6) == 270.0
+    assert corners[0].pivot_segment in (3, 4)  # at the middle of the two arcs

@@ -101,9 +101,29 @@ def test_no_corner_of_the_crank_web_slots_gets_a_wedge():
     # face the length of the web on each side (90 % of the quads in blocks).
     from pathlib import Path
 
+    from quadcnn_wb.core.field.pairs import without_cancelling_pairs
+    from quadcnn_wb.core.field.reference import background_and_field
     from quadcnn_wb.core.input.load import load_domain
+    from quadcnn_wb.core.input.small_holes import squared_holes
+    from quadcnn_wb.core.layout.motorcycle import stop_at_first_hits
+    from quadcnn_wb.core.layout.tracing import trace_streamlines
 
     domain = load_domain(Path(__file__).parent / "corpus" / "crankshaft_web_keyway.brep")
-    result = mesh_domain(domain, size=diameter(domain) / 100)
-    assert result.structured_share >= 0.97
-    assert result.quality["min_scaled_jacobian"] > 0.5
+    size = diameter(domain) / 100
+    layout = squared_holes(domain, size)
+    background, field = background_and_field(layout, 2048, {}, strict=False,
+                                             feature_size=size)
+    field = without_cancelling_pairs(field, background.element_size)
+    lines = stop_at_first_hits(trace_streamlines(layout, background, field),
+                               background.element_size, 1e-9 * layout.size)
+    moved = without_corner_wedges(layout, background, lines, size)
+    changed = [k for k, (a, b) in enumerate(zip(lines, moved)) if a is not b]
+    assert len(changed) == 2  # one at each slot's outer corner
+    for k in changed:
+        assert moved[k].start.kind == "singularity" and moved[k].end.kind == "streamline"
+        target = lines[moved[k].end.index]
+        assert target.start.kind == "corner"  # the corner's own line
+        along = moved[k].end.param * target.length
+        assert along == pytest.approx(JUNCTION_REACH * size)
+    result = mesh_domain(domain, size=size)
+    assert result.structured_share == 1.0, result.problem

@@ -176,9 +176,13 @@ def _loop_features(li, loop, size) -> list:
     gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
     # A fillet an element long or more is a feature on its own: the corner beside it
     # is one of the part's, not a detail of the fillet.
+    # Not from the other half of a fillet stored as two arcs, though (a crank web's
+    # rounded slot corner at diameter/100: two 233° corners an element apart, each
+    # with its own streamlines, beside the singular point the fillet put there).
     long = [t[5] - t[4] >= size and not _slot_end(loop, t, size) for t in turns]
-    gaps = [reach if long[k] or long[(k + 1) % len(turns)] else gap
-            for k, gap in enumerate(gaps)]
+    gaps = [reach if (long[k] or long[(k + 1) % len(turns)])
+            and not _split_fillet(loop, t, turns[(k + 1) % len(turns)]) else gap
+            for k, (t, gap) in enumerate(zip(turns, gaps))]
     if len(turns) > 1 and max(gaps) < reach:
         return out  # the whole loop is one chain: read as it is
     first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
@@ -193,6 +197,27 @@ def _loop_features(li, loop, size) -> list:
         if feature is not None:
             out.append(feature)
     return out
+
+
+def _split_fillet(loop, first, second) -> bool:
+    """Whether consecutive turns lie inside one fillet stored as two arcs: concave arcs
+    one after the other, joined smoothly (a kink under SMOOTH_TURN, itself a turn or
+    not), turning by at most ROUND_SWEEP together."""
+    n = len(loop)
+    if first[3] == "curve" and second[3] == "curve":
+        arcs = (first[2], second[2]) if second[2] == (first[2] + 1) % n else None
+    elif first[3] == "curve" and second[3] == "joint":
+        arcs = (first[2], second[2]) if second[2] == (first[2] + 1) % n else None
+    elif first[3] == "joint" and second[3] == "curve":
+        arcs = ((second[2] - 1) % n, second[2]) if first[2] == second[2] else None
+    else:
+        arcs = None
+    if arcs is None:
+        return False
+    a, b = loop[arcs[0]], loop[arcs[1]]
+    sweep_a, sweep_b = getattr(a, "sweep", 0.0), getattr(b, "sweep", 0.0)
+    return sweep_a < 0.0 and sweep_b < 0.0 and -(sweep_a + sweep_b) <= ROUND_SWEEP \
+        and is_smooth_join(interior_angle(a, b))
 
 
 def _slot_end(loop, turn, size) -> bool:
