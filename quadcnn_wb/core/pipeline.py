@@ -304,6 +304,7 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
                     worst_allowed, stop_at_free, False, state)
     if not allow_free:
         return found
+    hexagons_cut = False
     if any(HEXAGON in face.reason for face in found[1].free_faces):
         # Six-cornered faces that no rebuild made into blocks: cut in two
         # (layout.subdivide), at the price of an irregular vertex at each end of the
@@ -313,7 +314,8 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         try:
             cut = _rounds(domain, background, lines, cuts, size, smoothing, timings,
                           allow_free, worst_allowed, stop_at_free, True, state)
-            found = cut if _mesh_key(cut[3]) > _mesh_key(found[3]) else found
+            if _mesh_key(cut[3]) > _mesh_key(found[3]):
+                found, hexagons_cut = cut, True
         except PartitionError:
             pass
     lens = _lens_lines(found[1]) - state["dissolve"]
@@ -321,12 +323,11 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         return found
     # Two-cornered faces between a line and the rim (a line from a hole's corner that
     # hugs the hole's side to the next corner): the line goes, and the face with it.
-    # Kept if the mesh is better.
+    # Kept if the mesh is better; hexagons are cut as in the mesh it must beat.
     state = dict(state, dissolve=state["dissolve"] | lens)
     try:
         merged = _rounds(domain, background, lines, cuts, size, smoothing, timings,
-                         allow_free, worst_allowed, stop_at_free,
-                         any(HEXAGON in f.reason for f in found[1].free_faces), state)
+                         allow_free, worst_allowed, stop_at_free, hexagons_cut, state)
     except PartitionError:
         return found
     return merged if _mesh_key(merged[3]) > _mesh_key(found[3]) else found
