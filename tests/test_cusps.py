@@ -57,3 +57,23 @@ def test_a_crescent_gets_the_same_mesh_in_every_pose():
         q = result.quality
         seen.add((q["blocks"], q["quads"], q["irregular_vertices"], result.structured_share))
     assert len(seen) == 1
+
+
+@pytest.mark.parametrize("nudge", [-1e-12, 0.0, 1e-12])
+def test_a_tip_between_tangent_curves_is_read_by_the_curves_not_by_round_off(nudge):
+    # An arc arriving at the tip heading up, and a line leaving it straight down: the
+    # tangent turns back, and the sign of that half turn was round-off (a JSON round
+    # trip of a blend plate read its horn as 360° instead of 0°, and the face fell
+    # back).  Where the line lies on the domain's side of the arc, the tip is a cusp
+    # (0°); the same curves the other way round make a 360° notch.
+    from quadcnn_wb.core.input.curves import Arc, Line
+
+    r = 5.0
+    a = np.radians([60.0, 30.0, 0.0])
+    points = np.column_stack([r - r * np.cos(a), -r * np.sin(a)])
+    arc = Arc.through(*points)  # arrives at the origin heading up
+    line = Line(np.zeros(2), np.array([nudge, -5.0]))
+    assert interior_angle(arc, line) == pytest.approx(0.0, abs=1e-5)
+    back_line = Line(np.array([nudge, -5.0]), np.zeros(2))
+    back_arc = Arc.through(*points[::-1])
+    assert interior_angle(back_line, back_arc) == pytest.approx(2 * math.pi, abs=1e-5)

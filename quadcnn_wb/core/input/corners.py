@@ -19,10 +19,27 @@ CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not 
 QUARTER_TIE = 1e-6  # quarter turns: angles this close to an odd multiple of 45° are that tie
 
 
+REVERSAL = 1e-6  # radians: a tangent that turns back this nearly is read by the curves
+REVERSAL_PROBE = 0.05  # ... a point this share of the shorter curve from the joint
+
+
 def interior_angle(incoming, outgoing) -> float:
-    """Angle on the domain's side (the left) between consecutive curves at their joint."""
+    """Angle on the domain's side (the left) between consecutive curves at their joint.
+
+    Where the tangent turns back (tangent curves meeting at a tip), the sign of the
+    turn is round-off: the same horn read 0° in one copy of a part and 360° in another
+    (a JSON round trip of a blend plate: a cusp's kite against three corner lines of no
+    length, and the whole face fell back).  There the curves themselves tell: the tip
+    is a cusp (0°) where the outgoing curve lies to the left of the incoming one, the
+    domain's side, and a 360° notch otherwise."""
     t_in, t_out = incoming.tangent(1.0), outgoing.tangent(0.0)
     turn = math.atan2(cross2(t_in, t_out), float(np.dot(t_in, t_out)))
+    if math.pi - abs(turn) < REVERSAL:
+        reach = REVERSAL_PROBE * min(incoming.length, outgoing.length)
+        before = incoming.point(1.0 - reach / incoming.length)
+        after = outgoing.point(reach / outgoing.length)
+        turn = math.pi if cross2(t_in, np.asarray(after) - np.asarray(before)) > 0.0 \
+            else -math.pi
     return math.pi - turn
 
 

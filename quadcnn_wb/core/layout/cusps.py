@@ -38,6 +38,7 @@ ARM_LEAN = math.radians(60)  # between an arm and the direction from M back to t
 ARM_POINTS = 4  # polyline points per arm
 SEARCH = 3.0  # reaches along each side searched for the point nearest M
 SEARCH_SAMPLES = 600
+TIP_START = 0.5  # background sizes from a cusp's tip to where a line traced from it starts
 
 
 def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
@@ -109,7 +110,17 @@ def _from_tip(domain, background, field, lines, node) -> list:
     h = background.element_size
     tris = np.nonzero((background.triangles == node).any(axis=1))[0]
     start = start_triangle(background.walker, tris, tip, bisector, h)
-    (line,) = integrate(domain, background, field, [(tip, bisector, start, corner)])
+    # Between tangent curves the bisector runs along both sides, on the boundary; the
+    # trace leaves from the middle of the horn a little way in (halfway between the
+    # sides' points TIP_START sizes from the tip), which lies inside whatever the sign
+    # of round-off.
+    inside = _horn_middle(loop, si, t, TIP_START * h)
+    if inside is not None and np.hypot(*(inside - tip)) > 0.0:
+        heading = (inside - tip) / np.hypot(*(inside - tip))
+        (line,) = integrate(domain, background, field, [(inside, heading, start, corner)])
+        line = dataclasses.replace(line, points=np.vstack([tip, line.points]))
+    else:
+        (line,) = integrate(domain, background, field, [(tip, bisector, start, corner)])
     every = list(lines) + [line]
     new = len(lines)
     hits = [((s_i, j, s_j) if i == new else (s_j, i, s_i))
@@ -126,6 +137,18 @@ def _from_tip(domain, background, field, lines, node) -> list:
             line, points=np.vstack([pts[cum < s], point_at(pts, cum, s)]),
             end=Endpoint("streamline", j, param=float(s_j / other)))
     return [line]
+
+
+def _horn_middle(loop, si, t, reach):
+    """Halfway between the two sides' points ``reach`` along them from the tip at
+    segment si, parameter t; None where a side is shorter than that."""
+    tip = (si, t)
+    sides = [_walk(loop, tip, step, reach, 1) for step in (1, -1)]
+    if any(not side for side in sides):
+        return None
+    a = loop[sides[0][-1][0]].point(sides[0][-1][1])
+    b = loop[sides[1][-1][0]].point(sides[1][-1][1])
+    return 0.5 * (np.asarray(a, dtype=float) + np.asarray(b, dtype=float))
 
 
 def _kite(domain, lines, k, which, reach) -> list:
