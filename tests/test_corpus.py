@@ -22,7 +22,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # Partly in blocks: some faces of the partition get unstructured quads (free faces).
-PARTLY_BLOCKS = {"perforated_plate"}
+PARTLY_BLOCKS = {"perforated_plate", "blend_horn_plate"}
 NO_BLOCKS_YET = PARTLY_BLOCKS
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
@@ -177,7 +177,9 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # mirror image got other counts (177 blocks and 381 quads against 179 and 361) while
 # its edges were measured by chords and the merges refused to a pinch were found along
 # links in the pose's node order; blend_plate_hole: a separatrix ended on the singular
-# point it passes (field_rules: measured along the lines, alike in every pose).
+# point it passes (field_rules: measured along the lines, alike in every pose);
+# blend_horn_plate: its horns' tips read 0° or 360° and their tip quads flat or not as
+# round-off had it in each pose (input.corners, pipeline.TIP_JACOBIAN).
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
@@ -185,7 +187,7 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
                                   "nist_ctc01_plate", "anc101_flange",
                                   "crankshaft_web_keyway", "bracket_plate",
                                   "grabcad_part19", "nist_ctc04_plate",
-                                  "blend_plate_hole"])
+                                  "blend_plate_hole", "blend_horn_plate"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

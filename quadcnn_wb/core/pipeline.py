@@ -33,6 +33,8 @@ from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jac
 from .mesh.quality import mesh_quality, structured_share
 
 MIN_VALID_JACOBIAN = 0.05  # a block-structured mesh worse than this is not handed out
+TIP_JACOBIAN = 1e-6  # ... but a quad at a cusp's tip need only beat this: not fold, and
+# not be flat to round-off (three corners on one line read 0 or 1e-17 by the pose)
 
 
 @dataclass
@@ -404,7 +406,7 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
         sj = scaled_jacobians(mesh.nodes, mesh.quads)
         # A quad at a cusp's tip is as good as the tip lets it be: it need only not fold.
         tip = tip_quads(background, mesh.nodes, mesh.quads, size)
-        bad = sj <= np.where(tip, 0.0, MIN_VALID_JACOBIAN)
+        bad = sj <= np.where(tip, TIP_JACOBIAN, MIN_VALID_JACOBIAN)
         if not tiles_exactly(mesh.nodes, mesh.quads):
             bad |= crossing_quads(mesh.nodes, mesh.quads)  # blocks folded over others
         folded = {_block_key(partition, int(b)) for b in mesh.block_of_quad[bad] if b >= 0}
@@ -419,8 +421,8 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
     state.update(dissolve=dissolve, freed=freed, unbalanced=unbalanced)
     if not len(sj):
         worst = 0.0
-    elif (sj[tip] <= 0.0).any():
-        worst = float(sj[tip].min())  # folded at a cusp's tip
+    elif (sj[tip] <= TIP_JACOBIAN).any():
+        worst = float(sj[tip].min())  # folded (or flat) at a cusp's tip
     else:
         worst = float(sj[~tip].min(initial=1.0))  # tip quads: as good as their tips allow
     if worst <= worst_allowed:
