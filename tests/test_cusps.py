@@ -77,3 +77,19 @@ def test_a_tip_between_tangent_curves_is_read_by_the_curves_not_by_round_off(nud
     back_line = Line(np.array([nudge, -5.0]), np.zeros(2))
     back_arc = Arc.through(*points[::-1])
     assert interior_angle(back_line, back_arc) == pytest.approx(2 * math.pi, abs=1e-5)
+
+
+@pytest.mark.parametrize("divisor", [None, 100])
+def test_a_tangent_horns_kite_sits_where_the_horn_is_half_an_element_wide(divisor):
+    # blend_horn_square's horn: a quarter arc tangent to a straight side.  One element
+    # from the tip its sides are a fiftieth of an element apart at diameter/100, and the
+    # kite there was a sliver (worst scaled Jacobian 0.022; 0.077 at the default size);
+    # a horn elsewhere folded its kite and left the whole face unstructured.
+    from pathlib import Path
+
+    from quadcnn_wb.core.input.load import load_domain
+
+    domain = load_domain(Path(__file__).parent / "corpus" / "blend_horn_square.brep")
+    result = mesh_domain(domain, size=None if divisor is None else diameter(domain) / divisor)
+    assert result.structured_share == 1.0, result.problem
+    assert result.quality["min_scaled_jacobian"] > 0.1

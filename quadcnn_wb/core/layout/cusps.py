@@ -39,6 +39,10 @@ ARM_POINTS = 4  # polyline points per arm
 SEARCH = 3.0  # reaches along each side searched for the point nearest M
 SEARCH_SAMPLES = 600
 TIP_START = 0.5  # background sizes from a cusp's tip to where a line traced from it starts
+TANGENT_TIP = math.radians(0.5)  # a cusp this sharp is a horn between tangent curves ...
+HORN_WIDTH = 0.5  # ... whose kite sits where the horn is this many sizes wide ...
+HORN_SEARCH = 6.0  # ... looked for this many sizes in
+HORN_SAMPLES = 60
 
 
 def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
@@ -48,6 +52,8 @@ def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
     until it meets another line or the boundary."""
     cusps = sorted(int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
                    if a < SHARP_LOW)
+    tangent = {int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
+               if a < TANGENT_TIP}
     lines = list(lines)
     for node in cusps:
         if not _lines_at(lines, node):
@@ -58,7 +64,10 @@ def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
         if len(at) == 1:
             k, which = at[0]
             total = float(cumulative_length(np.asarray(lines[k].points, dtype=float))[-1])
-            cuts.append((k, which, min(KITE_REACH * size, KITE_SHARE * total)))
+            reach = KITE_REACH * size
+            if node in tangent:  # a horn between tangent curves: as far in as it is wide
+                reach = max(reach, _horn_reach(domain, background, node, size))
+            cuts.append((k, which, min(reach, KITE_SHARE * total)))
     for k, which, reach in cuts:
         lines = _kite(domain, lines, k, which, reach)
     return tuple(lines)
@@ -137,6 +146,22 @@ def _from_tip(domain, background, field, lines, node) -> list:
             line, points=np.vstack([pts[cum < s], point_at(pts, cum, s)]),
             end=Endpoint("streamline", j, param=float(s_j / other)))
     return [line]
+
+
+def _horn_reach(domain, background, node, size) -> float:
+    """How far from a tangent horn's tip its two sides are HORN_WIDTH sizes apart (at
+    most HORN_SEARCH sizes): a kite nearer the tip is a sliver between curves that
+    part as the square of the distance, and its quads fold on the curved side."""
+    corner = corner_endpoint(background, node)
+    loop = domain.loops[corner.loop]
+    tip = (corner.segment, corner.param)
+    steps = np.linspace(KITE_REACH, HORN_SEARCH, HORN_SAMPLES) * size
+    sides = [_walk(loop, tip, step, float(steps[-1]), HORN_SAMPLES) for step in (1, -1)]
+    a = np.array([loop[seg].point(t) for seg, t, _ in sides[0]])
+    b = np.array([loop[seg].point(t) for seg, t, _ in sides[1]])
+    wide = np.nonzero(np.hypot(*(a - b).T) >= HORN_WIDTH * size)[0]
+    along = np.array([x[2] for x in sides[0]])
+    return float(along[wide[0]]) if len(wide) else float(steps[-1])
 
 
 def _horn_middle(loop, si, t, reach):
