@@ -204,15 +204,12 @@ def _split_fillet(loop, first, second) -> bool:
     one after the other, joined smoothly (a kink under SMOOTH_TURN, itself a turn or
     not), turning by at most ROUND_SWEEP together."""
     n = len(loop)
-    if first[3] == "curve" and second[3] == "curve":
-        arcs = (first[2], second[2]) if second[2] == (first[2] + 1) % n else None
-    elif first[3] == "curve" and second[3] == "joint":
-        arcs = (first[2], second[2]) if second[2] == (first[2] + 1) % n else None
-    elif first[3] == "joint" and second[3] == "curve":
-        arcs = ((second[2] - 1) % n, second[2]) if first[2] == second[2] else None
+    # A curve's turn is numbered by its segment, a joint's by the segment it starts.
+    if first[3] == "curve" and second[2] == (first[2] + 1) % n:
+        arcs = (first[2], second[2])  # the next arc, or the joint that starts it
+    elif first[3] == "joint" and second[3] == "curve" and first[2] == second[2]:
+        arcs = ((second[2] - 1) % n, second[2])  # the joint that ends the arc before
     else:
-        arcs = None
-    if arcs is None:
         return False
     a, b = loop[arcs[0]], loop[arcs[1]]
     sweep_a, sweep_b = getattr(a, "sweep", 0.0), getattr(b, "sweep", 0.0)

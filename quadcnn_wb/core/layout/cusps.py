@@ -50,10 +50,8 @@ def with_cusp_kites(domain, background, field, lines, size: float) -> tuple:
     that none runs into (no singular point beside it: a lens between two bores, whose
     two cusps make up the disk's count) gets one, traced from the tip along the field
     until it meets another line or the boundary."""
-    cusps = sorted(int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
-                   if a < SHARP_LOW)
-    tangent = {int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
-               if a < TANGENT_TIP}
+    cusps = _tips(background, SHARP_LOW)
+    tangent = set(_tips(background, TANGENT_TIP))
     lines = list(lines)
     for node in cusps:
         if not _lines_at(lines, node):
@@ -84,16 +82,20 @@ def tip_quads(background, nodes, quads, size: float) -> np.ndarray:
     scaled Jacobian under the pipeline's floor there says nothing about the layout
     (a square with a tangent horn at diameter/100: 0.034 at the tip, and the whole face
     went to gmsh's quads, 0.016 at the same tip)."""
-    tips = [background.nodes[int(n)] for n, a in zip(background.corner_nodes,
-                                                     background.corner_angles)
-            if a < SHARP_LOW]
+    tips = background.nodes[_tips(background, SHARP_LOW)]
     out = np.zeros(len(quads), dtype=bool)
-    if not tips or not len(nodes):
+    if not len(tips) or not len(nodes):
         return out
-    gap = np.hypot(nodes[:, None, 0] - np.array(tips)[None, :, 0],
-                   nodes[:, None, 1] - np.array(tips)[None, :, 1]).min(axis=1)
+    gap = np.hypot(nodes[:, None, 0] - tips[None, :, 0],
+                   nodes[:, None, 1] - tips[None, :, 1]).min(axis=1)
     at_tip = gap <= TIP_MATCH * size
     return at_tip[quads].any(axis=1)
+
+
+def _tips(background, below: float) -> list:
+    """The corner nodes whose interior angle is under ``below``, in node order."""
+    return sorted(int(n) for n, a in zip(background.corner_nodes, background.corner_angles)
+                  if a < below)
 
 
 def _lines_at(lines, node) -> list:
@@ -123,9 +125,11 @@ def _from_tip(domain, background, field, lines, node) -> list:
     # trace leaves from the middle of the horn a little way in (halfway between the
     # sides' points TIP_START sizes from the tip), which lies inside whatever the sign
     # of round-off.
-    inside = _horn_middle(loop, si, t, TIP_START * h)
-    if inside is not None and np.hypot(*(inside - tip)) > 0.0:
-        heading = (inside - tip) / np.hypot(*(inside - tip))
+    a, b, _ = _horn_sides(loop, (si, t), TIP_START * h, 1)
+    inside = 0.5 * (a[-1] + b[-1])
+    lean = float(np.hypot(*(inside - tip)))
+    if lean > 0.0:
+        heading = (inside - tip) / lean
         (line,) = integrate(domain, background, field, [(inside, heading, start, corner)])
         line = dataclasses.replace(line, points=np.vstack([tip, line.points]))
     else:
@@ -154,26 +158,19 @@ def _horn_reach(domain, background, node, size) -> float:
     part as the square of the distance, and its quads fold on the curved side."""
     corner = corner_endpoint(background, node)
     loop = domain.loops[corner.loop]
-    tip = (corner.segment, corner.param)
-    steps = np.linspace(KITE_REACH, HORN_SEARCH, HORN_SAMPLES) * size
-    sides = [_walk(loop, tip, step, float(steps[-1]), HORN_SAMPLES) for step in (1, -1)]
-    a = np.array([loop[seg].point(t) for seg, t, _ in sides[0]])
-    b = np.array([loop[seg].point(t) for seg, t, _ in sides[1]])
+    a, b, along = _horn_sides(loop, (corner.segment, corner.param), HORN_SEARCH * size,
+                              HORN_SAMPLES)
     wide = np.nonzero(np.hypot(*(a - b).T) >= HORN_WIDTH * size)[0]
-    along = np.array([x[2] for x in sides[0]])
-    return float(along[wide[0]]) if len(wide) else float(steps[-1])
+    return float(along[wide[0]]) if len(wide) else HORN_SEARCH * size
 
 
-def _horn_middle(loop, si, t, reach):
-    """Halfway between the two sides' points ``reach`` along them from the tip at
-    segment si, parameter t; None where a side is shorter than that."""
-    tip = (si, t)
-    sides = [_walk(loop, tip, step, reach, 1) for step in (1, -1)]
-    if any(not side for side in sides):
-        return None
-    a = loop[sides[0][-1][0]].point(sides[0][-1][1])
-    b = loop[sides[1][-1][0]].point(sides[1][-1][1])
-    return 0.5 * (np.asarray(a, dtype=float) + np.asarray(b, dtype=float))
+def _horn_sides(loop, tip, distance, samples) -> tuple:
+    """The points of the two sides leaving the tip (segment, parameter) at ``samples``
+    equal steps out to ``distance`` along each, and those arc lengths."""
+    sides = [_walk(loop, tip, step, distance, samples) for step in (1, -1)]
+    a, b = (np.array([loop[seg].point(t) for seg, t, _ in side], dtype=float)
+            for side in sides)
+    return a, b, np.array([x[2] for x in sides[0]])
 
 
 def _kite(domain, lines, k, which, reach) -> list:

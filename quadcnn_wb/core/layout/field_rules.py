@@ -213,12 +213,9 @@ def _ended_on_passed_points(lines, h):
         if passes:
             cut, _, j = min(passes)  # the first point it passes
             # Bent onto the point over its last stretch, not kinked at the nearest pass.
-            point = lines[j].points[0]
-            kept = np.asarray(shifted_tail(line.points[:cut + 1], point - line.points[cut],
-                                           ARRIVAL_BLEND * h), dtype=float)
-            kept[-1] = point
             out[k] = dataclasses.replace(
-                line, points=kept,
+                line, points=bent_to(line.points[:cut + 1], lines[j].points[0],
+                                     ARRIVAL_BLEND * h),
                 end=Endpoint("singularity", lines[j].start.index, branch=lines[j].start.branch))
     return out
 
@@ -237,10 +234,9 @@ def _near_pass(line, other, h):
     if not len(within):
         return None
     first = int(within[0])
-    run = first
-    while run + 1 < len(dist) and dist[run + 1] <= PASSED_MISS * h:
-        run += 1
-    nearest = first + int(np.argmin(dist[first:run + 1]))
+    away = np.nonzero(dist[first:] > PASSED_MISS * h)[0]
+    run_end = first + int(away[0]) if len(away) else len(dist)  # the first pass ends
+    nearest = first + int(np.argmin(dist[first:run_end]))
     if nearest == 0 or nearest >= len(line.points) - 1:
         return None
     back = heading(line.points[nearest::-1], h)  # where the line came from, seen there
@@ -372,6 +368,15 @@ def shifted_tail(path, shift, reach) -> list:
     if reach <= 0:
         return path
     return list(points + tail_weights(cum[-1] - cum, reach)[:, None] * shift)
+
+
+def bent_to(points, place, reach) -> np.ndarray:
+    """``points`` ending exactly at ``place``, the stretch before the end bent there
+    smoothly over ``reach`` (shifted_tail)."""
+    points = np.asarray(points, dtype=float)
+    bent = np.asarray(shifted_tail(points, np.asarray(place) - points[-1], reach), dtype=float)
+    bent[-1] = place
+    return bent
 
 
 def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> Streamline:

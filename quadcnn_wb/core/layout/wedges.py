@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from .crossings import cumulative_length, point_at
-from .field_rules import corner_endpoint, shifted_tail
+from .field_rules import bent_to, corner_endpoint
 from .streamlines import Endpoint
 from .tracing import SNAP_BLEND
 
@@ -50,7 +50,7 @@ def without_corner_wedges(domain, background, lines, size: float) -> tuple:
     return tuple(lines)
 
 
-def _rays(lines, corner_xy, node: int) -> list:
+def _rays(lines, node: int) -> list:
     """(line, 0 for its start or 1 for its end) of every line with an end at the corner:
     ended there, or ended on another line's end that is the corner."""
     out = []
@@ -87,8 +87,7 @@ def _wedge_moves(domain, background, lines, node, size, h) -> list:
     after = loop[si] if t <= 0.0 else loop[(si + 1) % len(loop)]
     leaving = np.asarray(after.tangent(0.0), dtype=float)
     arriving = -np.asarray(before.tangent(1.0), dtype=float)
-    xy = background.nodes[node]
-    rays = _rays(lines, xy, node)
+    rays = _rays(lines, node)
     if not rays:
         return []
 
@@ -120,7 +119,7 @@ def _wedge_moves(domain, background, lines, node, size, h) -> list:
     _, target, target_which = placed[far]
     if lines[target].end.kind == "streamline" and target_which == 1:
         return []  # itself a junction at the corner: no line of the corner's own
-    length = float(cumulative_length(np.asarray(lines[target].points, dtype=float))[-1])
+    length = lines[target].length
     s = min(JUNCTION_REACH * size, JUNCTION_SHARE * length)
     if s <= 0.0 or _junction_within(lines, target, target_which, s, length):
         return []
@@ -144,11 +143,8 @@ def _end_on(lines, k, target, s, h) -> list:
     cum = cumulative_length(pts)
     place = point_at(pts, cum, s)
     line = lines[k]
-    points = np.asarray(line.points, dtype=float)
-    moved = np.asarray(shifted_tail(points, place - points[-1], SNAP_BLEND * h), dtype=float)
-    moved[-1] = place
     out = list(lines)
-    out[k] = dataclasses.replace(line, points=moved,
+    out[k] = dataclasses.replace(line, points=bent_to(line.points, place, SNAP_BLEND * h),
                                  end=Endpoint("streamline", target,
                                               param=float(s / float(cum[-1]))))
     return out
