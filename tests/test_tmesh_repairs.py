@@ -1,6 +1,7 @@
 """What the T-mesh does with faces and arcs that are too small or too many-cornered for a
 block: a short boundary arc beside a trace's end takes no segment, so the strip it
-bounds collapses; a six-cornered face is cut in two between opposite corners."""
+bounds collapses; a six-cornered face is cut in two between opposite corners; as the last
+resort, faces of more corners or with reflex ones are split round a centre."""
 
 from __future__ import annotations
 
@@ -81,7 +82,7 @@ def test_a_six_cornered_face_is_cut_where_the_cut_leaves_the_widest_angles():
     # Of the three cuts between opposite corners, the one across the middle leaves 56°
     # either side at both its ends; the diagonals leave 37°.
     domain = _elongated_hexagon()
-    partition = build_partition(domain, [], 1.0, cut_hexagons=True)
+    partition = build_partition(domain, [], 1.0, last_resort=True)
     assert len(partition.blocks) == 2 and not partition.free_faces
     inner = [edge for edge in partition.edges if not edge.is_boundary]
     assert len(inner) == 1
@@ -89,6 +90,47 @@ def test_a_six_cornered_face_is_cut_where_the_cut_leaves_the_widest_angles():
     assert ends == [(-1.0, 1.5), (5.0, 1.5)]
     mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
     assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.5
+
+
+def _l_shape():
+    return domain_from_json({"loops": [polygon([[0, 0], [6, 0], [6, 3], [3, 3], [3, 6],
+                                                [0, 6]])]})
+
+
+def test_a_face_with_a_reflex_corner_is_split_round_a_centre_as_the_last_resort():
+    # The L's reflex corner is a spoke's end, as the middles of the sides between two
+    # convex corners are: five blocks, one per convex corner, and no side beside the
+    # reflex corner cut.
+    domain = _l_shape()
+    plain = build_partition(domain, [], 1.0)
+    assert not plain.blocks and "turns back" in plain.free_faces[0].reason
+    partition = build_partition(domain, [], 1.0, last_resort=True)
+    assert len(partition.blocks) == 5 and not partition.free_faces
+    spokes = [edge for edge in partition.edges if not edge.is_boundary]
+    ends = {tuple(partition.vertices[edge.b].round(9)) for edge in spokes}
+    assert ends == {(3.0, 0.0), (6.0, 1.5), (3.0, 3.0), (1.5, 6.0), (0.0, 3.0)}
+    mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
+    assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.3
+
+
+def test_two_reflex_corners_side_by_side_leave_the_face_free():
+    # A U: its two reflex corners at the slot's floor are one side apart, so no block
+    # would have a convex corner between them.
+    domain = domain_from_json({"loops": [polygon([[0, 0], [6, 0], [6, 6], [4, 6], [4, 2],
+                                                  [2, 2], [2, 6], [0, 6]])]})
+    partition = build_partition(domain, [], 1.0, last_resort=True)
+    assert not partition.blocks and len(partition.free_faces) == 1
+
+
+def test_a_seven_cornered_face_is_split_round_a_centre_as_the_last_resort():
+    angles = 2 * np.pi * np.arange(7) / 7
+    domain = domain_from_json({"loops": [polygon(np.column_stack(
+        [5 * np.cos(angles), 5 * np.sin(angles)]).tolist())]})
+    assert "has 7 corners" in build_partition(domain, [], 1.0).free_faces[0].reason
+    partition = build_partition(domain, [], 1.0, last_resort=True)
+    assert len(partition.blocks) == 7 and not partition.free_faces
+    mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
+    assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.3
 
 
 def test_boundary_edges_are_measured_along_their_curves():

@@ -23,7 +23,7 @@ from .input.small_holes import squared_holes
 from .layout.cusps import tip_quads, with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
-from .layout.partition import build_partition, corners_instead_of_4
+from .layout.partition import STAR_CORNERS, build_partition, corners_instead_of_4
 from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
@@ -306,18 +306,23 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
                     worst_allowed, stop_at_free, False, state)
     if not allow_free:
         return found
-    hexagons_cut = False
-    if any(HEXAGON in face.reason for face in found[1].free_faces):
-        # Six-cornered faces that no rebuild made into blocks: cut in two
-        # (layout.subdivide), at the price of an irregular vertex at each end of the
-        # cut, where the faces' quads are unstructured otherwise.  Kept if the mesh is
-        # better (more in blocks, fair).  The rounds go on from where the first ones
-        # stopped (what they dissolved and gave up).
+    last_resorted = False
+    if any(any(why in face.reason for why in LAST_RESORT_REASONS)
+           for face in found[1].free_faces):
+        # Six-cornered faces that no rebuild made into blocks: cut in two; faces of more
+        # corners, or with reflex ones: split round a centre (layout.subdivide), at the
+        # price of irregular vertices at the cut's ends or the centre, where the faces'
+        # quads are unstructured otherwise.  Kept if the mesh is better (fair, more in
+        # blocks) and no less of it in blocks: blocks it could only give up again (their
+        # maps fold) would leave a fair mesh by freeing what was blocks before (0073 of
+        # the held-out faces: 0.70 of it in blocks, then 0.29).  The rounds go on from
+        # where the first ones stopped (what they dissolved and gave up).
         try:
             cut = _rounds(domain, background, lines, cuts, size, smoothing, timings,
                           allow_free, worst_allowed, stop_at_free, True, state)
-            if _mesh_key(cut[3]) > _mesh_key(found[3]):
-                found, hexagons_cut = cut, True
+            before, after = _mesh_key(found[3]), _mesh_key(cut[3])
+            if after > before and after[1] >= before[1]:
+                found, last_resorted = cut, True
         except PartitionError:
             pass
     lens = _lens_lines(found[1]) - state["dissolve"]
@@ -325,17 +330,19 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
         return found
     # Two-cornered faces between a line and the rim (a line from a hole's corner that
     # hugs the hole's side to the next corner): the line goes, and the face with it.
-    # Kept if the mesh is better; hexagons are cut as in the mesh it must beat.
+    # Kept if the mesh is better; the last resort is taken as in the mesh it must beat.
     state = dict(state, dissolve=state["dissolve"] | lens)
     try:
         merged = _rounds(domain, background, lines, cuts, size, smoothing, timings,
-                         allow_free, worst_allowed, stop_at_free, hexagons_cut, state)
+                         allow_free, worst_allowed, stop_at_free, last_resorted, state)
     except PartitionError:
         return found
     return merged if _mesh_key(merged[3]) > _mesh_key(found[3]) else found
 
 
-HEXAGON = corners_instead_of_4(6)  # in the reason of a six-cornered free face
+# In the reasons of the free faces the last resort may make into blocks.
+LAST_RESORT_REASONS = tuple(corners_instead_of_4(n) for n in range(6, STAR_CORNERS + 1)) \
+    + ("turns back",)
 LENS = corners_instead_of_4(2)  # ... and of a two-cornered one
 
 
@@ -354,7 +361,7 @@ def _lens_lines(partition: Partition) -> frozenset:
 
 
 def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
-            worst_allowed, stop_at_free, cut_hexagons, state):
+            worst_allowed, stop_at_free, last_resort, state):
     """blocks_and_mesh's partitions and rebuilds, with or without cutting hexagons;
     ``state`` holds the edges dissolved and blocks given up so far, and is updated."""
     dissolve, freed, unbalanced = state["dissolve"], set(state["freed"]), set(state["unbalanced"])
@@ -362,7 +369,7 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
         clock = time.perf_counter()
         partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
                                     background.flat_joints, background.feature_corners,
-                                    cut_hexagons)
+                                    last_resort)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")

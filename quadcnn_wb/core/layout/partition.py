@@ -40,6 +40,11 @@ from .subdivide import split_odd_faces
 TURN_TIE = 1e-6  # radians: turns this close to CORNER_TURN are exactly at it
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
 PROMOTED_TURN = math.radians(20)  # a three-cornered face's fourth corner bends at least this
+# The last resort (build_partition's ``last_resort``): faces of up to this many corners,
+# and faces with reflex corners that turn back by at most STAR_REFLEX, are split round a
+# centre (subdivide.py) instead of being left free.
+STAR_CORNERS = 8
+STAR_REFLEX = math.radians(135)
 
 
 # ----------------------------------------------------------------------------------------
@@ -69,7 +74,7 @@ def _boundary_key(domain, loop: int, seg: int, t: float):
 
 def build_partition(domain, streamlines, element_size: float, cuts=(),
                     dissolve=frozenset(), flat_joints=frozenset(),
-                    feature_corners=frozenset(), cut_hexagons=False) -> Partition:
+                    feature_corners=frozenset(), last_resort=False) -> Partition:
     """Blocks cut out by the streamlines and the ``cuts`` (extra streamlines, see cuts.py),
     less the streamline edges whose origin is in ``dissolve`` (faces merged where a free
     face could not be filled).  ``flat_joints``: (loop, segment) of the loop vertices in a
@@ -78,9 +83,11 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     ``feature_corners``: (loop, segment, parameter, angle) of such features' corners
     inside a curve (BackgroundMesh.feature_corners): vertices, as a loop's corners are,
     where a face turns by the feature's whole turn (its curve turns a little within the
-    reach that measures a face's turns elsewhere).  ``cut_hexagons``: a six-cornered
-    face becomes two blocks (subdivide.py) instead of a free face; its cut's ends become
-    irregular vertices, so that is the last resort (pipeline.blocks_and_mesh)."""
+    reach that measures a face's turns elsewhere).  ``last_resort``: a six-cornered
+    face becomes two blocks (subdivide.py) instead of a free face, and a face of up to
+    STAR_CORNERS corners or with reflex corners (none next to another, none turning
+    back by more than STAR_REFLEX) becomes blocks round a centre; the cut's ends and the
+    centres are irregular vertices, so that is the last resort (pipeline.blocks_and_mesh)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -143,15 +150,16 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     turns = _vertex_turns(verts.xy, bends, tol)
     # Without the slivers' edges where that leaves no more free faces than with them
     # (where no sliver edge went, the two builds are one).
-    corner_counts = (3, 4, 5, 6) if cut_hexagons else (3, 4, 5)
-    thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True, corner_counts)
+    corner_counts = tuple(range(3, STAR_CORNERS + 1)) if last_resort else (3, 4, 5)
+    thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True, corner_counts,
+                                   last_resort)
     if thinned[4]:
         kept = _faces_without_slits(verts.xy, edges, element_size, turns, False,
-                                    corner_counts)
+                                    corner_counts, last_resort)
         thinned = kept if len(kept[2]) < len(thinned[2]) else thinned
     edges, faces, free, islands, _ = thinned
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
-                                             unsplit=dissolve)
+                                             unsplit=dissolve, star=last_resort)
     blocks, free = _with_holes(blocks, free, islands, edges, element_size)
     used = {v for edge in edges for v in (edge.a, edge.b)}
     singular = tuple(sorted(singular & used))
@@ -186,12 +194,14 @@ def _at_places(vertices, places, tol) -> set:
     return out
 
 
-def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts) -> tuple:
+def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts,
+                         star=False) -> tuple:
     """(edges, faces, free faces, islands, whether a sliver edge went) once no slit,
     island outline (and, with ``slivers``, sliver edge) is left."""
     thinned = False
     while True:
-        faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns, corner_counts)
+        faces, free, islands = _faces_to_blocks(np.array(xy), edges, h, turns, corner_counts,
+                                                star)
         slits = _slits(free, edges) \
             | {e for island in islands for e, _ in island if not edges[e].is_boundary}
         if slivers:
@@ -420,7 +430,8 @@ def _slivers(free, faces, edges, h) -> set:
     dropping them frees faces: the hexagon's separatrices side by side out of singular
     points a hair apart collapse into one mesh line, zero segment counts, instead.)"""
     walks = [face.halves for face in free]
-    walks += [tuple(h for side in sides for h in side) for _, sides in faces if len(sides) != 4]
+    walks += [tuple(h for side in face[1] for h in side) for face in faces
+              if len(face[1]) != 4 or face[2]]
     out = set()
     for halves in walks:
         outline = _outline(edges, halves)
@@ -628,7 +639,10 @@ def _vertex_turns(xy, bends, tol) -> dict:
     return out
 
 
-def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4, 5)):
+def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4, 5),
+                     star=False):
+    """(faces, free faces, islands): a face is (corner vertex ids, sides, the indices in
+    its corners of reflex ones); ``star``: see build_partition's ``last_resort``."""
     reach = 0.5 * h
     half = []  # (edge id, forward)
     out_dirs: dict = {}
@@ -681,7 +695,7 @@ def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4,
             continue
         try:
             blocks.append(_block_of(cycle, half, edges, vertices, h, head, vertex_turns or {},
-                                    corner_counts))
+                                    corner_counts, star))
         except PartitionError as exc:
             places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
                       for c in cycle]
@@ -740,7 +754,7 @@ def corners_instead_of_4(n: int) -> str:
     return f"has {n} corners instead of 4"
 
 
-def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts):
+def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts, star):
     reach = 0.5 * h
     turns = []
     for k, hid in enumerate(cycle):
@@ -764,14 +778,19 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
     outline = np.vstack([edges[e].points if f else edges[e].points[::-1]
                          for e, f in (half[c] for c in cycle)])
     tips = np.array([vertices[head(c)] for c in cycle])
-    if np.any(turns < -CORNER_TURN):
-        k = int(np.argmin(turns))
-        raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
-                             f"{fmt(vertices[head(cycle[k])])}: not a four-sided block")
+    reflex = turns < -CORNER_TURN
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]
-    if len(corner_at) == 3:
+    if reflex.any():
+        k = int(np.argmin(turns))
+        if not (star and _star_face(turns, corner_at, [head(c) for c in cycle])):
+            raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
+                                 f"{fmt(vertices[head(cycle[k])])}: not a four-sided block")
+        corner_at = np.nonzero(reflex | (turns > CORNER_TURN))[0]
+    elif len(corner_at) == 3:
         corner_at = _with_fourth_corner(turns, corner_at)
-    if len(corner_at) not in corner_counts:
+    if star and len(corner_at) >= 6 and len(set(head(c) for c in cycle)) < len(cycle):
+        raise PartitionError("a block touches itself: not a four-sided block")
+    if not reflex.any() and len(corner_at) not in corner_counts:
         centre = np.mean([vertices[head(c)] for c in cycle], axis=0)
         raise PartitionError(f"a block near {fmt(centre)} {corners_instead_of_4(len(corner_at))}",
                              outline, tips[corner_at])
@@ -790,4 +809,17 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
             k = (k + 1) % len(cycle)
         sides.append([half[cycle[i]] for i in idx])
         corners.append(head(cycle[corner_at[s]]))
-    return corners, sides
+    return corners, sides, tuple(int(j) for j in np.nonzero(reflex[corner_at])[0])
+
+
+def _star_face(turns, corner_at, places) -> bool:
+    """Whether a face with reflex corners can be split round a centre: from 3 to
+    STAR_CORNERS other corners, no reflex corner turning back by more than STAR_REFLEX
+    or next to another, and no place passed twice (a pinch)."""
+    reflex = turns < -CORNER_TURN
+    if turns.min() < -STAR_REFLEX or not 3 <= len(corner_at) <= STAR_CORNERS:
+        return False
+    kinds = reflex[np.nonzero(reflex | (turns > CORNER_TURN))[0]]
+    if (kinds & np.roll(kinds, -1)).any():
+        return False
+    return len(set(places)) == len(places)

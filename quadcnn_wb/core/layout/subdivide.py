@@ -9,6 +9,14 @@ price of a block-structured mesh there.  A face too concave for that stays a fre
 (unstructured quads, see free_faces.py).  A six-cornered face (when the partition is
 asked for it: the last resort, see partition.build_partition) is instead cut straight
 between two opposite corners into two blocks, an extra edge at each end of the cut.
+
+The last resort also splits round a centre what would otherwise stay free: a six-cornered
+face with no such cut, faces of up to eight corners, and faces with reflex corners (a
+trace dropped, a singular point's sector left open).  A reflex corner takes a side middle's
+place as a spoke's end: the spoke halves its angle, so that each block still has one of
+the face's convex corners, two spoke ends and the centre (no side next to a reflex corner
+is cut; two reflex corners side by side leave no block between them, so such a face stays
+free).  Every spoke must then lie inside the face.
 """
 
 from __future__ import annotations
@@ -39,71 +47,152 @@ def split_key(vertices, corners) -> tuple:
 
 
 def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain,
-                    unsplit=frozenset()):
+                    unsplit=frozenset(), star=False):
     """(vertex list, blocks, free faces): four-cornered faces as they are, others
     subdivided; free faces follow the edges split on their way.  A face whose split is
     in ``unsplit`` (its blocks became a free face that could not be filled: the spokes
-    are what a rebuild can take away) stays whole, a free face."""
+    are what a rebuild can take away) stays whole, a free face.  ``star`` (the last
+    resort): a six-cornered face with no cut is split round a centre too, and so is a
+    face with reflex corners (see _star_targets)."""
     vertices = list(vertices)
     blocks = []
     free_halves = [(list(f.halves), f.reason) for f in free]
-    everything = list(faces) + [(None, [halves]) for halves, _ in free_halves]
+    everything = [(face[0], face[1]) for face in faces] \
+        + [(None, [halves]) for halves, _ in free_halves]
     # Six-cornered faces are cut between two opposite corners first (no centre, no new
     # side middles): their cut is decided on the sides as they are now, which the other
     # faces' splits only subdivide.
-    halved = []
+    halved, odd = [], []
     for face in faces:
-        if len(face[0]) == 6:
-            corners, sides = face
+        corners, sides, reflex = face
+        if len(corners) == 6 and not reflex:
             key = split_key(vertices, corners)
             at = None if key in unsplit else _opposite_corners(vertices, edges, corners, sides)
-            if at is None:
+            if at is not None:
+                halved.append((corners, sides, at, key))
+            elif star and key not in unsplit:
+                odd.append((corners, sides, reflex))
+            else:
                 why = "whose split could not be filled" if key in unsplit \
                     else "has no cut into two quadrilaterals"
                 centre = np.mean([vertices[c] for c in corners], axis=0)
                 halves = [h for side in sides for h in side]
                 free_halves.append((halves, f"a 6-cornered block near {fmt(centre)} {why}"))
                 everything.append((None, [halves]))
-            else:
-                halved.append((face, at, key))
-    odd = [f for f in faces if len(f[0]) not in (4, 6)]
+        elif len(corners) != 4 or reflex:
+            odd.append((corners, sides, reflex))
     # Every side's middle first: a later face's split cuts an edge of an earlier face's
     # side too, and that face's blocks must be made from its sides as finally cut.
-    all_mids = [[_split_side(vertices, edges, everything, sides, j, domain)
-                 for j in range(len(sides))] for _, sides in odd]
-    for (corners, sides), mids in zip(odd, all_mids):
-        centre = np.mean([vertices[m] for m in mids] + [vertices[c] for c in corners], axis=0)
-        polygon = np.array([vertices[c] for c in corners])
+    all_mids = [[None if _next_to_reflex(j, len(corners), reflex)
+                 else _split_side(vertices, edges, everything, sides, j, domain)
+                 for j in range(len(sides))] for corners, sides, reflex in odd]
+    for (corners, sides, reflex), mids in zip(odd, all_mids):
+        k = len(corners)
+        targets = [mids[j] if mids[j] is not None else corners[(j + 1) % k]
+                   for j in range(k) if j not in reflex]  # after each convex corner
+        convex = [corners[j] for j in range(k) if j not in reflex]
+        centre = np.mean([vertices[t] for t in targets] + [vertices[c] for c in convex],
+                         axis=0)
         key = split_key(vertices, corners)
-        if key in unsplit or not inside_polygon(polygon, centre):
+        if key not in unsplit and not _centre_sees(vertices, edges, corners, sides, reflex,
+                                                   centre, targets) \
+                and (reflex or k >= 6):
+            # The mean of a concave face's corners may not see them all; the middle of
+            # the face's kernel (what sees all of its outline) does where there is one.
+            outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
+            kernel = _kernel(outline)
+            if kernel is not None:
+                centre = kernel
+        if key in unsplit or not _centre_sees(vertices, edges, corners, sides, reflex,
+                                              centre, targets):
             halves = [h for side in sides for h in side]
             why = "whose split could not be filled" if key in unsplit \
                 else "is too concave to split into quadrilaterals"
-            free_halves.append((halves, f"a {len(corners)}-cornered block near "
+            free_halves.append((halves, f"a {k}-cornered block near "
                                 f"{fmt(centre)} {why}"))
             everything.append((None, [halves]))
             continue
         c_id = len(vertices)
         vertices.append(centre)
-        spokes = []
-        for m in mids:
-            pts = np.linspace(centre, vertices[m], 8)
-            spokes.append(len(edges))
-            edges.append(Edge(points=pts, a=c_id, b=m, origin=key))
-        k = len(corners)
+        spoke = {}
+        for t in targets:
+            spoke[t] = len(edges)
+            edges.append(Edge(points=np.linspace(centre, vertices[t], 8), a=c_id, b=t,
+                              origin=key))
         for j in range(k):
-            first_half = sides[j][: _mid_index(sides[j], edges, mids[j]) + 1]
+            if j in reflex:
+                continue
             prev = (j - 1) % k
-            second_half = sides[prev][_mid_index(sides[prev], edges, mids[prev]) + 1:]
-            blocks.append(Block(corners=(corners[j], mids[j], c_id, mids[prev]),
-                                sides=(tuple(first_half), ((spokes[j], False),),
-                                       ((spokes[prev], True),), tuple(second_half))))
-    for (corners, sides), at, key in halved:
+            # From corner j to the target after it (side j's middle, or the reflex corner
+            # that ends side j), and from the target before it (side prev's middle, or the
+            # reflex corner that starts side prev) back to corner j.
+            if mids[j] is not None:
+                to_next, after = sides[j][: _mid_index(sides[j], edges, mids[j]) + 1], mids[j]
+            else:
+                to_next, after = sides[j], corners[(j + 1) % k]
+            if mids[prev] is not None:
+                from_prev = sides[prev][_mid_index(sides[prev], edges, mids[prev]) + 1:]
+                before = mids[prev]
+            else:
+                from_prev, before = sides[prev], corners[prev]
+            blocks.append(Block(corners=(corners[j], after, c_id, before),
+                                sides=(tuple(to_next), ((spoke[after], False),),
+                                       ((spoke[before], True),), tuple(from_prev))))
+    for corners, sides, at, key in halved:
         blocks.extend(_halves_of_hexagon(vertices, edges, corners, sides, at, key))
-    for corners, sides in faces:
-        if len(corners) == 4:
-            blocks.append(Block(corners=tuple(corners), sides=tuple(tuple(s) for s in sides)))
+    for face in faces:
+        if len(face[0]) == 4 and not face[2]:
+            blocks.append(Block(corners=tuple(face[0]),
+                                sides=tuple(tuple(s) for s in face[1])))
     return vertices, blocks, [FreeFace(tuple(h), reason) for h, reason in free_halves]
+
+
+def _next_to_reflex(j: int, k: int, reflex) -> bool:
+    """Whether side j (from corner j to corner j + 1 of k) has a reflex corner at an end:
+    that corner is its block's target, so the side gets no middle."""
+    return j in reflex or (j + 1) % k in reflex
+
+
+def _kernel(outline):
+    """The mean of the vertices of a counter-clockwise outline's kernel (the points that see
+    all of it: inside every edge's left half-plane), or None where it is empty."""
+    lo, hi = outline.min(axis=0), outline.max(axis=0)
+    poly = np.array([lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]], dtype=float)
+    nxt = np.roll(outline, -1, axis=0)
+    scale = float(np.hypot(*(hi - lo)))
+    for a, b in zip(outline, nxt):
+        if np.hypot(*(b - a)) <= 1e-12 * scale:
+            continue
+        side = _side_of(a, b, poly)
+        keep = side >= 0.0
+        if keep.all():
+            continue
+        if not keep.any():
+            return None
+        out = []
+        for i in range(len(poly)):
+            j = (i + 1) % len(poly)
+            if keep[i]:
+                out.append(poly[i])
+            if keep[i] != keep[j]:
+                f = side[i] / (side[i] - side[j])
+                out.append(poly[i] + f * (poly[j] - poly[i]))
+        poly = np.array(out)
+        if len(poly) < 3:
+            return None
+    return poly.mean(axis=0)
+
+
+def _centre_sees(vertices, edges, corners, sides, reflex, centre, targets) -> bool:
+    """Whether the spokes from the centre can go in: the centre inside the corners'
+    polygon, and (in a face with reflex corners or more than six) every spoke inside the
+    face."""
+    if not inside_polygon(np.array([vertices[c] for c in corners]), centre):
+        return False
+    if not reflex and len(corners) < 6:
+        return True
+    outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
+    return all(_inside(outline, centre, np.asarray(vertices[t])) for t in targets)
 
 
 MIN_CUT_ANGLE = np.radians(30.0)  # the least angle a hexagon's cut may leave at a corner
