@@ -1,7 +1,8 @@
 """What the T-mesh does with faces and arcs that are too small or too many-cornered for a
 block: a short boundary arc beside a trace's end takes no segment, so the strip it
 bounds collapses; a six-cornered face is cut in two between opposite corners; as the last
-resort, faces of more corners or with reflex ones are split round a centre."""
+resort, faces of more corners or with reflex ones are split round a centre; a lens takes
+its two sharpest bends as corners."""
 
 from __future__ import annotations
 
@@ -90,6 +91,25 @@ def test_a_six_cornered_face_is_cut_where_the_cut_leaves_the_widest_angles():
     assert ends == [(-1.0, 1.5), (5.0, 1.5)]
     mesh = build_quad_mesh(domain, partition, quantize(partition, 1.0))
     assert scaled_jacobians(mesh.nodes, mesh.quads).min() > 0.5
+
+
+def _lens(depth):
+    """An arc over a three-segment floor whose two bends turn by atan(depth / 3)."""
+    return domain_from_json({"loops": [[
+        {"line": [[0, 0], [3, -depth]]}, {"line": [[3, -depth], [7, -depth]]},
+        {"line": [[7, -depth], [10, 0]]}, {"arc": [[10, 0], [5, 3], [0, 0]]}]]})
+
+
+def test_a_two_cornered_face_gets_its_sharpest_two_bends_as_corners():
+    # Bends of 21.8° (over PROMOTED_TURN): one block, cornered at the arc's ends and
+    # at the bends; bends of 11.3° are no corners, and the lens stays a free face.
+    partition = build_partition(_lens(1.2), [], 1.0)
+    assert len(partition.blocks) == 1 and not partition.free_faces
+    corners = sorted(map(tuple, partition.vertices[list(partition.blocks[0].corners)]
+                         .round(9)))
+    assert corners == [(0.0, 0.0), (3.0, -1.2), (7.0, -1.2), (10.0, 0.0)]
+    flat = build_partition(_lens(0.6), [], 1.0)
+    assert not flat.blocks and "has 2 corners" in flat.free_faces[0].reason
 
 
 def _l_shape():

@@ -748,6 +748,22 @@ def _with_fourth_corner(turns, corner_at):
     return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
 
 
+def _with_two_more_corners(turns, corner_at):
+    """A two-cornered face (a lens: a separatrix hugging the boundary from one singular
+    point to the next, past a flat between two scallops) whose sides bend somewhere by
+    PROMOTED_TURN or more at two places gets its third and fourth corners at the two
+    sharpest bends: one block, where the lens is no block at all.  A tie for the second
+    place leaves the face as it is, so that no pose decides it."""
+    rest = np.setdiff1d(np.arange(len(turns)), corner_at)
+    rest = rest[turns[rest] >= PROMOTED_TURN]
+    if len(rest) < 2:
+        return corner_at
+    ranked = rest[np.argsort(-turns[rest], kind="stable")]
+    if len(ranked) > 2 and turns[ranked[1]] - turns[ranked[2]] <= TURN_TIE:
+        return corner_at
+    return np.sort(np.concatenate([corner_at, ranked[:2]]))
+
+
 def corners_instead_of_4(n: int) -> str:
     """How a free face's reason names a face with n corners (pipeline.blocks_and_mesh
     looks for six)."""
@@ -788,6 +804,8 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
         corner_at = np.nonzero(reflex | (turns > CORNER_TURN))[0]
     elif len(corner_at) == 3:
         corner_at = _with_fourth_corner(turns, corner_at)
+    elif len(corner_at) == 2:
+        corner_at = _with_two_more_corners(turns, corner_at)
     if star and len(corner_at) >= 6 and len(set(head(c) for c in cycle)) < len(cycle):
         raise PartitionError("a block touches itself: not a four-sided block")
     if not reflex.any() and len(corner_at) not in corner_counts:
