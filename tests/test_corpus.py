@@ -22,7 +22,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # Partly in blocks: some faces of the partition get unstructured quads (free faces).
-PARTLY_BLOCKS = {"perforated_plate", "blend_horn_plate"}
+PARTLY_BLOCKS = {"perforated_plate", "blend_horn_plate", "blend_sawtooth", "blend_scallop_slots"}
 NO_BLOCKS_YET = PARTLY_BLOCKS
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
@@ -114,11 +114,13 @@ FINE_TOO_SLOW = {"perforated_plate"}
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
 # against 12; gmsh alg. 11 has 387 and 144).
 FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19"}
+# Free faces there too (blend_sawtooth: 0.95 of it in blocks).
+FINE_PARTLY_BLOCKS = {"blend_sawtooth"}
 
 
 @pytest.mark.parametrize("name", [
-    expected_failure(n, FINE_EXTRA_IRREGULAR, "free faces or irregular vertices the field "
-                                              "does not have")
+    expected_failure(n, FINE_EXTRA_IRREGULAR | FINE_PARTLY_BLOCKS,
+                     "free faces or irregular vertices the field does not have")
     for n in MESHABLE if n not in FINE_TOO_SLOW])
 def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
     from quadcnn_wb.core.input.pose import diameter
@@ -179,7 +181,19 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # links in the pose's node order; blend_plate_hole: a separatrix ended on the singular
 # point it passes (field_rules: measured along the lines, alike in every pose);
 # blend_horn_plate: its horns' tips read 0° or 360° and their tip quads flat or not as
-# round-off had it in each pose (input.corners, pipeline.TIP_JACOBIAN).
+# round-off had it in each pose (input.corners, pipeline.TIP_JACOBIAN); blend_sawtooth:
+# the line moved off a wedge at a tooth's root was the first in the traces' order, which
+# a mirror image reverses (layout.wedges); blend_scallop_slots: a corner's trace of no
+# length took a separatrix's slot, flat fill quads read 0 or +-1e-17, tied smoothing
+# moves went to the first in a compass a mirror image reverses, and which of two lines
+# side by side lost its edge followed the traces' numbering.
+# Moved by 1e4 of its size, blend_sawtooth's coordinates (1.6e6) hold its teeth's
+# smallest quads (edges of 2e-5 of its size) to about 1e-7 of their size, past the 1e-9
+# that the max-min moves compare at: the moves go another way, blocks fold, and every
+# layout falls back (its other poses agree).  Meshing in the canonical pose would mend it.
+SAWTOOTH_FAR_OFF = "moved by 1e4 of its size: tooth quads at the moves' rounding"
+
+
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
@@ -187,7 +201,10 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
                                   "nist_ctc01_plate", "anc101_flange",
                                   "crankshaft_web_keyway", "bracket_plate",
                                   "grabcad_part19", "nist_ctc04_plate",
-                                  "blend_plate_hole", "blend_horn_plate"])
+                                  "blend_plate_hole", "blend_horn_plate",
+                                  expected_failure("blend_sawtooth", {"blend_sawtooth"},
+                                                   SAWTOOTH_FAR_OFF),
+                                  "blend_scallop_slots"])
 def test_a_part_gets_the_same_mesh_in_every_pose(name):
     import numpy as np
 

@@ -269,6 +269,13 @@ def _arrival_branches(lines, h):
         own_traces = [(branch, own) for (kind, index, branch), own in leaving.items()
                       if (kind, index) == (end.kind, end.index) and len(own.points) > 1]
         coming = heading(line.points[::-1], ARRIVAL_REACH * h)
+        if not coming.any():
+            # No length, no heading (a corner's trace that left the domain at once): it
+            # arrives along none of the point's separatrices.  Every cosine would be 0,
+            # and the first branch in the point's numbering, which a mirror image
+            # reverses, would have been its slot, taken from the line that runs there.
+            out.append(line)
+            continue
         best, best_cos = end.branch, -np.inf
         for branch, own in own_traces:
             cos = float(coming @ heading(own.points, ARRIVAL_REACH * h))

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..input.corners import interior_angle
 from ..input.features import is_smooth_join
-from .crossings import crossings, end_places, point_at
+from .crossings import crossings, cumulative_length, end_places, point_at
 from .partition_types import (
     BoundaryPiece,
     Edge,
@@ -145,17 +145,18 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     edges = [edge for edge in edges if edge.is_boundary or edge.origin not in dissolve]
     singular = {v for key, v in verts.by_key.items() if key[0] == "s"}
     edges = _one_vertex_per_place(edges, np.array(verts.xy), element_size, singular)
+    order = _line_order(lines, element_size)
     edges = _without_dangling(_without_doubles(_without_zero_length(edges, element_size),
-                                               element_size))
+                                               element_size, order))
     turns = _vertex_turns(verts.xy, bends, tol)
     # Without the slivers' edges where that leaves no more free faces than with them
     # (where no sliver edge went, the two builds are one).
     corner_counts = tuple(range(3, STAR_CORNERS + 1)) if last_resort else (3, 4, 5)
     thinned = _faces_without_slits(verts.xy, edges, element_size, turns, True, corner_counts,
-                                   last_resort)
+                                   last_resort, order)
     if thinned[4]:
         kept = _faces_without_slits(verts.xy, edges, element_size, turns, False,
-                                    corner_counts, last_resort)
+                                    corner_counts, last_resort, order)
         thinned = kept if len(kept[2]) < len(thinned[2]) else thinned
     edges, faces, free, islands, _ = thinned
     vertices, blocks, free = split_odd_faces(verts.xy, edges, faces, free, domain,
@@ -194,8 +195,8 @@ def _at_places(vertices, places, tol) -> set:
     return out
 
 
-def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts,
-                         star=False) -> tuple:
+def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts, star,
+                         order) -> tuple:
     """(edges, faces, free faces, islands, whether a sliver edge went) once no slit,
     island outline (and, with ``slivers``, sliver edge) is left."""
     thinned = False
@@ -205,12 +206,36 @@ def _faces_without_slits(xy, edges, h, turns, slivers: bool, corner_counts,
         slits = _slits(free, edges) \
             | {e for island in islands for e, _ in island if not edges[e].is_boundary}
         if slivers:
-            thin = _slivers(free, faces, edges, h) - slits
+            thin = _slivers(free, faces, edges, h, order) - slits
             thinned = thinned or bool(thin)
             slits |= thin
         if not slits:
             return edges, faces, free, islands, thinned
         edges = _without_dangling([edge for e, edge in enumerate(edges) if e not in slits])
+
+
+def _line_order(lines, h) -> list:
+    """Each line's place in an order a turned, moved or mirrored copy shares: by length,
+    then by the distance of its middle from the lines' centre (rounded).  The lines'
+    numbering is the tracing's, which follows the separatrices' numbering round each
+    point: a mirror image's runs the other way, and where two lines side by side leave
+    one edge between them, the numbering chose which (held-out 0075: another sliver
+    dropped, other free faces)."""
+    if not lines:
+        return []
+    middles, lengths = [], []
+    for pts in lines:
+        cum = cumulative_length(pts)
+        lengths.append(float(cum[-1]))
+        middles.append(point_at(pts, cum, 0.5 * float(cum[-1])))
+    centre = np.mean(middles, axis=0)
+    keys = [(round(length / h, 6), round(float(np.hypot(*(m - centre))) / h, 6))
+            for length, m in zip(lengths, middles)]
+    ranked = sorted(range(len(lines)), key=lambda k: (keys[k], k))
+    order = [0] * len(lines)
+    for place, k in enumerate(ranked):
+        order[k] = place
+    return order
 
 
 def _used_vertices_only(partition: Partition) -> Partition:
@@ -305,18 +330,20 @@ def _without_zero_length(edges, h) -> list:
 DOUBLE_EDGE_GAP = 0.5  # two edges of the same ends closer than this (element sizes) are one
 
 
-def _without_doubles(edges, h) -> list:
+def _without_doubles(edges, h, order) -> list:
     """One edge where two join the same vertices side by side: two separatrices leaving a
     point together and one stopping on the other a step later make a sliver of no width,
     which no face walk can order (their directions at the vertex are the same).  The
-    boundary edge, else the earlier streamline's, stays."""
+    boundary edge, else the earlier streamline's in ``order`` (_line_order), stays."""
     by_ends: dict = {}
     for e, edge in enumerate(edges):
         if edge.a != edge.b:
             by_ends.setdefault(frozenset((edge.a, edge.b)), []).append(e)
     dropped = set()
     for group in by_ends.values():
-        group.sort(key=lambda e: (not edges[e].is_boundary, edges[e].streamline, e))
+        group.sort(key=lambda e: (not edges[e].is_boundary,
+                                  order[edges[e].streamline] if not edges[e].is_boundary else 0,
+                                  e))
         for i, keep in enumerate(group):
             if keep in dropped:
                 continue
@@ -419,14 +446,15 @@ def _slits(free, edges) -> set:
 SLIVER_WIDTH = 0.25  # element sizes: a free face thinner than this on average is a sliver
 
 
-def _slivers(free, faces, edges, h) -> set:
+def _slivers(free, faces, edges, h, order) -> set:
     """The streamline edges of faces thinner than SLIVER_WIDTH that are no four-sided
     block (free, or to be split round a middle vertex): a separatrix that runs along the
     boundary (or along another) a fraction of an element off it leaves a face no quad
     fits in, which its mesh line would only crowd.  Along the boundary, the face's
-    streamline edges go (the boundary is the line); between streamlines, the later
-    streamline's; but no edge whose loss would leave a line that ends on it hanging (its
-    T-junction gone, the face beyond turns back).  (build_partition keeps them all where
+    streamline edges go (the boundary is the line); between streamlines, those of the
+    later streamline in ``order`` (_line_order: the longer); but no edge whose loss
+    would leave a line that ends on it hanging (its T-junction gone, the face beyond
+    turns back).  (build_partition keeps them all where
     dropping them frees faces: the hexagon's separatrices side by side out of singular
     points a hair apart collapse into one mesh line, zero segment counts, instead.)"""
     walks = [face.halves for face in free]
@@ -440,8 +468,8 @@ def _slivers(free, faces, edges, h) -> set:
             continue  # (a strip of width w and length l: area w l, perimeter 2 l)
         inner = {e for e, _ in halves if not edges[e].is_boundary}
         if len(inner) == len(halves):
-            last = max(edges[e].streamline for e in inner)
-            inner = {e for e in inner if edges[e].streamline == last}
+            last = max(order[edges[e].streamline] for e in inner)
+            inner = {e for e in inner if order[edges[e].streamline] == last}
         rest = [edge for e, edge in enumerate(edges) if e not in inner]
         if len(_without_dangling(rest)) == len(rest):
             out.update(inner)  # (not where it would leave a line that ends on it hanging)

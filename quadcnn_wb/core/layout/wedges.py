@@ -33,6 +33,7 @@ WEDGE_ANGLE = math.radians(45)  # a sector this narrow beside a line is a wedge,
 HEADING_REACH = 0.5  # element sizes from the corner to where a line's heading is read
 JUNCTION_REACH = 0.5  # element sizes along the corner's line to the new T-junction ...
 JUNCTION_SHARE = 0.4  # ... but at most this share of that line
+ANGLE_TIE = 1e-9  # radians: sectors this close in angle are equal (no pose decides)
 
 
 def without_corner_wedges(domain, background, lines, size: float) -> tuple:
@@ -92,28 +93,51 @@ def _wedge_moves(domain, background, lines, node, size, h) -> list:
         return []
 
     def angle_from_leaving(d) -> float:
-        """Counterclockwise from the side leaving the corner: the interior lies there."""
+        """Counterclockwise from the side leaving the corner: the interior lies there (a
+        line along that side is at 0, whichever side of it round-off puts it)."""
         a = math.atan2(leaving[0] * d[1] - leaving[1] * d[0], float(np.dot(leaving, d)))
-        return a if a >= 0.0 else a + 2.0 * math.pi
+        a = a if a >= 0.0 else a + 2.0 * math.pi
+        return 0.0 if a >= 2.0 * math.pi - ANGLE_TIE else a
 
     interior = angle_from_leaving(arriving)
     placed = sorted((angle_from_leaving(_heading(lines[k], which, HEADING_REACH * h)), k,
                      which) for k, which in rays)
-    placed = [p for p in placed if 0.0 < p[0] < interior]
+    placed = [p for p in placed if ANGLE_TIE < p[0] < interior - ANGLE_TIE]
     quads = max(1, round(interior / (0.5 * math.pi)))  # the quads the corner's angle asks for
     if len(placed) + 1 <= quads:
         return []
     bounds = [0.0] + [p[0] for p in placed] + [interior]
-    wedges = []  # (narrower sector beside an arriving line, rank, side of that sector)
+    wedges = []  # (sector beside an arriving line, rank, side of that sector)
     for rank, (theta, _k, which) in enumerate(placed):
         if which == 1:
             low, high = theta - bounds[rank], bounds[rank + 2] - theta
-            wedges.append((low, rank, -1) if low <= high else (high, rank, 1))
-    if not wedges:
+            if low <= high + ANGLE_TIE:
+                wedges.append((low, rank, -1))
+            if high <= low + ANGLE_TIE:
+                wedges.append((high, rank, 1))
+    if not wedges or min(wedges)[0] >= WEDGE_ANGLE:
         return []
-    angle, rank, side = min(wedges)
-    far = rank - side  # the ray across the wider sector, on the far side from the wedge
-    if angle >= WEDGE_ANGLE or not 0 <= far < len(placed):
+    # The narrowest sector, wherever it is found: the sector between two arriving lines is
+    # found once for each, and which of them comes first in the turn from the corner's
+    # leaving side is the mirror image's last.  Of the lines that can move, the one with
+    # the longer stretch of its own to the corner line moves; a tie moves none.
+    narrowest = min(wedges)[0]
+    moves = [move for angle, rank, side in wedges if angle <= narrowest + ANGLE_TIE
+             for move in _move(lines, placed, rank, side, size)]
+    if not moves:
+        return []
+    keys = [_move_key(lines, move, h) for move in moves]
+    if keys.count(max(keys)) > 1 and len(set(moves)) > 1:
+        return []
+    return [moves[keys.index(max(keys))]]
+
+
+def _move(lines, placed, rank, side, size) -> list:
+    """The move of the arriving line placed at ``rank`` onto the ray across its wider
+    sector, on the far side from the wedge (none where there is no such corner line, or
+    a junction is already near its corner end)."""
+    far = rank - side
+    if not 0 <= far < len(placed):
         return []
     _, k, _ = placed[rank]
     _, target, target_which = placed[far]
@@ -124,6 +148,13 @@ def _wedge_moves(domain, background, lines, node, size, h) -> list:
     if s <= 0.0 or _junction_within(lines, target, target_which, s, length):
         return []
     return [(k, target, s if target_which == 0 else length - s)]
+
+
+def _move_key(lines, move, h) -> tuple:
+    """What decides between two lines that could move at one corner: the longer line,
+    then the longer target (rounded: a turned copy must decide alike)."""
+    k, target, _ = move
+    return round(lines[k].length / h, 6), round(lines[target].length / h, 6)
 
 
 def _junction_within(lines, target, which, s, length) -> bool:

@@ -126,13 +126,35 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
                 else _compass_trials(x, v, corners, steps)
             batch = np.repeat(corners[None], len(trial), axis=0)
             batch[:, around == v] = trial[:, None, :]
-            values = np.round(sj_batch(batch).min(axis=1), 9)
-            k = int(np.argmax(values))
-            if values[k] > current + 1e-9:
-                x[v] = trial[k]
-                if slide is not None:
-                    slide.t = ts[k]
-                improved = True
+            around_sj = sj_batch(batch)
+            values = np.round(around_sj.min(axis=1), 9)
+            best = values.max()
+            if not best > current + 1e-9:
+                continue
+            # Ties on the worst quad go to the better quads around on average.
+            tied = np.nonzero(values == best)[0]
+            means = np.round(around_sj[tied].mean(axis=1), 9)
+            tied = tied[means == means.max()]
+            if len(tied) > 1:
+                # Trials that still tie are mirror images about the compass's reference
+                # (or the same stretch of curve either way): the first in the list would
+                # be the mirrored copy's last.  Their mean is the same in both; it moves
+                # the node if it too does better, else the node stays.
+                if slide is None:
+                    point, t = trial[tied].mean(axis=0), None
+                else:
+                    t = float(np.mean([ts[k] for k in tied]))
+                    point = slide.curve.point(t)
+                mid = corners.copy()
+                mid[around == v] = point
+                if not round(float(sj_batch(mid).min()), 9) > current + 1e-9:
+                    continue
+            else:
+                point, t = trial[tied[0]], (ts[tied[0]] if slide is not None else None)
+            x[v] = point
+            if slide is not None:
+                slide.t = t
+            improved = True
         if not improved:
             break
     return x
