@@ -81,17 +81,16 @@ def test_every_face_is_block_structured(name):
 # Irregular vertices besides the singular points and feature corners, where known:
 # tailwheel_gusset's chamfer end (a 158° vertex with one quad), crank_arm_web's two
 # kite corners (layout.cusps), sketch_keyhole_plate's pair at the keyhole's foot,
-# grabcad_part19's two six-cornered faces beside its left bosses, each cut in two
-# (layout.subdivide: an irregular vertex at either end of the cut, where the faces had
-# unstructured quads before), nist_ctc04_plate's valence-3 node beside the corner of a
-# bolt hole's square at (112, 752), where that corner gets 4 quads instead of 2;
+# nist_ctc04_plate's four (137 irregular vertices and worst 0.68 until collapses could
+# no longer carry a vertex onto the boundary from most of an element away: 140 and 0.75;
+# gmsh alg. 11 has 217 and 0.20);
 # crankshaft_web_keyway's valence-3 and valence-5 vertices in the hub's two side bays
 # (its 2048-node layout, all blocks since layout.wedges: worst scaled Jacobian 0.84
 # against the finer layout's 0.71, which had none); blend_horn_square's kite corner at
 # its horn's 0° tip; blend_slotted_plate's four, not yet told apart (its slots' round
 # ends read as corners with four quads; 59 irregular vertices against gmsh's 179).
 KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyhole_plate": 2,
-                         "grabcad_part19": 4, "nist_ctc04_plate": 1,
+                         "nist_ctc04_plate": 4,
                          "crankshaft_web_keyway": 2, "blend_horn_square": 1,
                          "blend_slotted_plate": 4}
 
@@ -103,7 +102,10 @@ def test_the_irregular_vertices_are_the_fields_own(name):
     result = meshed(name)
     own = len(result.reference.field.singularities) + result.feature_corners
     extra = result.quality["irregular_vertices"] - own
-    assert 0 <= extra <= KNOWN_EXTRA_IRREGULAR.get(name, 0)
+    # Fewer is allowed: a feature corner whose quads happen to be as many as its angle
+    # asks is no irregular vertex (grabcad_part19: 44 against 20 singular points and 28
+    # feature corners).
+    assert extra <= KNOWN_EXTRA_IRREGULAR.get(name, 0)
 
 
 # At the second size of the corpus benchmark (bench.corpus: diameter / 100).  Not
@@ -175,7 +177,7 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # whose corners a turned or mirrored copy must place alike; crankshaft_web_keyway and
 # bracket_plate: slot ends read as corners, placed alike in every pose; grabcad_part19
 # and nist_ctc04_plate: short boundary arcs with no segment (the merged node on the
-# corner or half-way), on grabcad_part19 two six-cornered faces cut in two; nist_ctc04's
+# corner or half-way), and no vertex carried most of an element onto the boundary; nist_ctc04's
 # mirror image got other counts (177 blocks and 381 quads against 179 and 361) while
 # its edges were measured by chords and the merges refused to a pinch were found along
 # links in the pose's node order; blend_plate_hole: a separatrix ended on the singular

@@ -6,7 +6,8 @@ mesh line, node for node.  That is how separatrices running side by side become 
 line and thin strips vanish.  It must never pinch the domain: two boundary nodes, a
 boundary node and a singular point, or two singular points in one place are a conflict,
 reported with the merges that caused it, so that the segment-count program can forbid
-one of them (quantize.py) and the mesh builder never meets one.
+one of them (quantize.py) and the mesh builder never meets one.  Nor may it carry a
+vertex most of an element away (SLIDE_SPAN): chains of short arcs with no segments add up.
 """
 
 from __future__ import annotations
@@ -28,9 +29,14 @@ class NodeLayout:
     anchor: np.ndarray  # raw node that may not share a place with another anchor
     fixed: np.ndarray  # raw node at a boundary corner or a singular point
     along_boundary: Components  # raw nodes joined by no-segment boundary arcs
+    places: np.ndarray  # (partition vertices, 2): where the raw nodes that are vertices lie
+    longest_slide: float  # farthest apart two partition vertices may merge into one place
 
 
-def node_layout(partition, counts) -> NodeLayout:
+def node_layout(partition, counts, size: float | None = None) -> NodeLayout:
+    """``size``: the target element size; partition vertices further apart than
+    SLIDE_SPAN of it may not merge into one place (none: any merge, as the mesh builder
+    takes the counts the program gave)."""
     n = len(partition.vertices)
     edge_nodes = []
     boundary_ids = []
@@ -53,7 +59,16 @@ def node_layout(partition, counts) -> NodeLayout:
     for e, edge in enumerate(partition.edges):
         if edge.is_boundary and int(counts[e]) == 0:
             along.union(int(edge.a), int(edge.b))
-    return NodeLayout(edge_nodes, n, boundary, anchor, fixed, along)
+    return NodeLayout(edge_nodes, n, boundary, anchor, fixed, along,
+                      np.asarray(partition.vertices, dtype=float).reshape(-1, 2),
+                      np.inf if size is None else SLIDE_SPAN * size)
+
+
+# A chain of arcs with no segments (and strips of no width) puts every vertex on it in
+# one place: a few short arcs between T-junctions along a boss's side added up to most of
+# an element (grabcad_part19's 2048-node layout at its default size: a block corner moved
+# 4.6 mm of a 5 mm element down the side, and the blocks beside it folded).
+SLIDE_SPAN = 0.9
 
 
 def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
@@ -133,20 +148,44 @@ def conflicts(layout: NodeLayout, found: Merges, key=None) -> list:
         anchors = groups[root]
         if len(anchors) < 2 or _slid(layout, anchors):
             continue
-        out.append(_least_reasons(layout, links_of.get(root, []), anchors, key))
+        out.append(_least_reasons(layout, links_of.get(root, []), anchors, key, _pinches))
     return out
 
 
-def _least_reasons(layout, links, anchors, key) -> list:
+def stretches(layout: NodeLayout, found: Merges, key=None) -> list:
+    """For every place where partition vertices further apart than the longest slide
+    were merged (and no anchors pinched), merges that together stretch it: a least set,
+    found in the order of ``key`` (as conflicts)."""
+    if not np.isfinite(layout.longest_slide):
+        return []
+    key = key or (lambda reason: reason)
+    links_of: dict = {}
+    for u, v, reason in found.links:
+        links_of.setdefault(int(found.parent[u]), []).append((u, v, reason))
+    vertices: dict = {}
+    for x in range(len(layout.places)):
+        vertices.setdefault(int(found.parent[x]), []).append(x)
+    out = []
+    for root in sorted(vertices):
+        members = vertices[root]
+        if not layout.anchor[members].any():
+            continue  # interior vertices meet half-way, as side-by-side lines should
+        if len(members) > 1 and _span(layout, members) > layout.longest_slide:
+            out.append(_least_reasons(layout, links_of.get(root, []), members, key,
+                                      _stretches))
+    return out
+
+
+def _least_reasons(layout, links, members, key, test) -> list:
     reasons = sorted({reason for _, _, reason in links}, key=key)
     chosen = []
     for reason in reasons:
         chosen.append(reason)
-        if _pinches(layout, links, anchors, set(chosen)):
+        if test(layout, links, members, set(chosen)):
             break
     for reason in reversed(list(chosen)):
         rest = set(chosen) - {reason}
-        if _pinches(layout, links, anchors, rest):
+        if test(layout, links, members, rest):
             chosen.remove(reason)
     return chosen
 
@@ -169,3 +208,22 @@ def _slid(layout: NodeLayout, anchors) -> bool:
     return (len({layout.along_boundary.find(int(x)) for x in anchors}) == 1
             and all(layout.boundary[x] for x in anchors)
             and sum(bool(layout.fixed[x]) for x in anchors) <= 1)
+
+
+def _stretches(layout: NodeLayout, links, members, reasons) -> bool:
+    """Whether the links of these reasons alone put two partition vertices further apart
+    than the longest slide in one place."""
+    parts = Components()
+    for u, v, reason in links:
+        if reason in reasons:
+            parts.union(u, v)
+    together: dict = {}
+    for m in members:
+        together.setdefault(parts.find(m), []).append(m)
+    return any(len(group) > 1 and _span(layout, group) > layout.longest_slide
+               for group in together.values())
+
+
+def _span(layout: NodeLayout, vertices) -> float:
+    xy = layout.places[list(vertices)]
+    return float(np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1)).max())

@@ -35,7 +35,7 @@ import numpy as np
 from scipy.optimize import Bounds, LinearConstraint, milp
 from scipy.sparse import coo_matrix, lil_matrix
 
-from .collapse import conflicts, merges, node_layout
+from .collapse import conflicts, merges, node_layout, stretches
 from .crossings import cumulative_length, point_at
 from .partition_types import Partition, PartitionError
 
@@ -253,11 +253,18 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
                     np.concatenate([upper, np.full(n_edges, np.inf), upper,
                                     np.full(n_blocks, z_upper)]))
     forbidden = []  # rows: at least one segment among these variables
+    # ... and rows against stretches, kept only while they cost no block (a chain of
+    # short arcs may have no other way to close than to collapse).
+    unstretched, stretching = [], True
     for _ in range(MAX_ROUNDS):
-        extra = [(dict.fromkeys(f, 1), 1, np.inf) for f in forbidden]
+        extra = [(dict.fromkeys(f, 1), 1, np.inf) for f in forbidden + unstretched]
         result = milp(cost, constraints=[secants, problem.constraint(extra)],
                       integrality=integrality, bounds=bounds,
                       options={"time_limit": time_limit, "mip_rel_gap": 0.0})
+        if unstretched and (result.status == 2 or (
+                result.status == 0 and (result.x[3 * n_edges:] > 0.5).any())):
+            unstretched, stretching = [], False  # they cost blocks: as before them
+            continue
         if result.x is None and result.status == 2:  # proven infeasible
             raise InfeasibleCounts(f"no segment counts make opposite block sides equal "
                                    f"({result.message})")
@@ -268,12 +275,16 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks: bo
         freed = sorted(b for b in range(n_blocks) if result.x[z_col[b]] > 0.5)
         kept = [b for b in range(n_blocks) if b not in set(freed)]
         reduced = dataclasses.replace(partition, blocks=[partition.blocks[b] for b in kept])
-        layout = node_layout(reduced, counts)
+        layout = node_layout(reduced, counts, size if stretching else None)
         variables_of = functools.partial(_merge_variables, reduced, position)
-        found = conflicts(layout, merges(reduced, layout, counts), key=variables_of)
-        if not found:
+        found_merges = merges(reduced, layout, counts)
+        found = conflicts(layout, found_merges, key=variables_of)
+        stretched = stretches(layout, found_merges, key=variables_of) if not found else []
+        if not found and not stretched:
             return counts, freed
         for reasons in found:
             forbidden.append(sorted({v for reason in reasons for v in variables_of(reason)}))
+        for reasons in stretched:
+            unstretched.append(sorted({v for reason in reasons for v in variables_of(reason)}))
     raise PartitionError("the segment counts keep pinching the domain (merging boundary "
                          "nodes or singular points)")
