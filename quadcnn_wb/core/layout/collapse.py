@@ -141,9 +141,7 @@ def conflicts(layout: NodeLayout, found: Merges, key=None) -> list:
     groups: dict = {}
     for x in np.nonzero(layout.anchor)[0]:
         groups.setdefault(int(found.parent[x]), []).append(int(x))
-    links_of: dict = {}
-    for u, v, reason in found.links:
-        links_of.setdefault(int(found.parent[u]), []).append((u, v, reason))
+    links_of = _links_by_place(found)
     for root in sorted(groups):
         anchors = groups[root]
         if len(anchors) < 2 or _slid(layout, anchors):
@@ -159,9 +157,7 @@ def stretches(layout: NodeLayout, found: Merges, key=None) -> list:
     if not np.isfinite(layout.longest_slide):
         return []
     key = key or (lambda reason: reason)
-    links_of: dict = {}
-    for u, v, reason in found.links:
-        links_of.setdefault(int(found.parent[u]), []).append((u, v, reason))
+    links_of = _links_by_place(found)
     vertices: dict = {}
     for x in range(len(layout.places)):
         vertices.setdefault(int(found.parent[x]), []).append(x)
@@ -173,6 +169,14 @@ def stretches(layout: NodeLayout, found: Merges, key=None) -> list:
         if len(members) > 1 and _span(layout, members) > layout.longest_slide:
             out.append(_least_reasons(layout, links_of.get(root, []), members, key,
                                       _stretches))
+    return out
+
+
+def _links_by_place(found: Merges) -> dict:
+    """The merge links, by the place (canonical raw id) they merge into."""
+    out: dict = {}
+    for u, v, reason in found.links:
+        out.setdefault(int(found.parent[u]), []).append((u, v, reason))
     return out
 
 
@@ -193,14 +197,8 @@ def _least_reasons(layout, links, members, key, test) -> list:
 def _pinches(layout, links, anchors, reasons) -> bool:
     """Whether the links of these reasons alone put anchors together (other than a
     slide along the boundary)."""
-    parts = Components()
-    for u, v, reason in links:
-        if reason in reasons:
-            parts.union(u, v)
-    together: dict = {}
-    for a in anchors:
-        together.setdefault(parts.find(a), []).append(a)
-    return any(len(group) > 1 and not _slid(layout, group) for group in together.values())
+    return any(len(group) > 1 and not _slid(layout, group)
+               for group in _together(links, anchors, reasons))
 
 
 def _slid(layout: NodeLayout, anchors) -> bool:
@@ -213,15 +211,20 @@ def _slid(layout: NodeLayout, anchors) -> bool:
 def _stretches(layout: NodeLayout, links, members, reasons) -> bool:
     """Whether the links of these reasons alone put two partition vertices further apart
     than the longest slide in one place."""
+    return any(len(group) > 1 and _span(layout, group) > layout.longest_slide
+               for group in _together(links, members, reasons))
+
+
+def _together(links, members, reasons) -> list:
+    """The members in groups, one per place the links of these reasons alone make."""
     parts = Components()
     for u, v, reason in links:
         if reason in reasons:
             parts.union(u, v)
-    together: dict = {}
+    groups: dict = {}
     for m in members:
-        together.setdefault(parts.find(m), []).append(m)
-    return any(len(group) > 1 and _span(layout, group) > layout.longest_slide
-               for group in together.values())
+        groups.setdefault(parts.find(m), []).append(m)
+    return list(groups.values())
 
 
 def _span(layout: NodeLayout, vertices) -> float:
