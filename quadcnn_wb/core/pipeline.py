@@ -28,6 +28,17 @@ from .layout.partition_types import FreeFace, FreeFaceError, Partition, Partitio
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
 from .layout.wedges import without_corner_wedges
+from .layout_frame import (
+    frame_of,
+    framed_domain,
+    framed_line,
+    framed_size,
+    same_frame,
+    world_background,
+    world_domain,
+    world_field,
+    world_result,
+)
 from .mesh.gmsh_quads import gmsh_quad_mesh
 from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
 from .mesh.quality import mesh_quality, structured_share
@@ -112,12 +123,31 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     size = default_size(domain) if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
+    # Every copy of the part is meshed in one frame (core.layout_frame) and turned back.
+    frame = frame_of(domain)
+    framed = framed_domain(domain, frame)
+    if learned_streamlines is not None:
+        learned_streamlines = _learned_in_frame(learned_streamlines, frame)
     # Small round holes are squares to the layout only (input.small_holes): the result
     # holds the part as given, whose curves the exports name.
-    result = _best_layout(squared_holes(domain, size), size, nodes, method, smoothing,
-                          learned_streamlines, seconds)
-    result.domain = domain
-    return result
+    unit_size = framed_size(size, frame)
+    layout = same_frame(squared_holes(framed, unit_size), framed, domain, frame)
+    result = _best_layout(layout, unit_size, nodes, method, smoothing, learned_streamlines,
+                          seconds)
+    return world_result(result, frame, domain, size)
+
+
+def _learned_in_frame(learned_streamlines, frame):
+    """A learned source reads the part in its own frame (its network was trained on
+    parts as drawn): it is handed the layout's domain, background and field turned back,
+    and its lines are put in the frame."""
+    def in_frame(domain, background, field):
+        lines, problems = learned_streamlines(world_domain(domain, frame),
+                                              world_background(background, frame),
+                                              world_field(field, frame))
+        return [framed_line(line, frame) for line in lines], problems
+
+    return in_frame
 
 
 def _best_layout(domain, size, nodes, method, smoothing, learned_streamlines, seconds):

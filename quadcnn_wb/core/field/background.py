@@ -170,13 +170,15 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     splits = {(f.loop, f.pivot_segment): f.pivot_param for f in features
               if f.angle is not None and f.pivot_param > 0.0}
     # Rounded well above round-off (a moved or turned copy must ask gmsh for the same size).
-    unit_area = round(domain.area / pose.scale**2, KEY_DIGITS)
-    unit_perimeter = round(domain.perimeter / pose.scale, KEY_DIGITS)
+    # gmsh sees the part as the caller had it, in its canonical pose (core.layout_frame)
+    source, source_pose = domain.__dict__.get("_gmsh_source", (domain, pose))
+    unit_area = round(source.area / source_pose.scale**2, KEY_DIGITS)
+    unit_perimeter = round(source.perimeter / source_pose.scale, KEY_DIGITS)
     h = size_for_nodes(unit_area, unit_perimeter, domain.holes, nodes / GMSH_DENSITY)
     tolerance = max(NODE_TOLERANCE * nodes, NODE_SLACK)
     best = None
     with gmsh_session(threads) as session:
-        curve_tags = build_geometry(domain, pose, splits)
+        curve_tags = build_geometry(source, source_pose, splits)
         for option, value in (("Mesh.Algorithm", GMSH_ALGORITHM),
                               ("Mesh.MeshSizeFromPoints", 0),
                               ("Mesh.MeshSizeFromCurvature", 0),
