@@ -390,6 +390,25 @@ def _lens_lines(partition: Partition) -> frozenset:
     return frozenset(out)
 
 
+def _twin_lines(partition: Partition, element_size: float) -> frozenset:
+    """The longer of two streamline edges that alone bound a two-cornered face no wider
+    than an element: two traces that left different places and met on the same stretch
+    (grabcad_part19's bosses: lenses of half an element, which kept its 2048-node layout
+    from being all blocks).  Without it the face is its neighbour's; that neighbour's
+    side is the other line, between the same two corners."""
+    out = set()
+    for face in partition.free_faces:
+        if LENS not in face.reason or face.holes or len(face.halves) != 2:
+            continue
+        a, b = (partition.edges[e] for e, _ in face.halves)
+        if a.is_boundary or b.is_boundary:
+            continue
+        gaps = np.hypot(*(a.points[:, None, :] - b.points[None, :, :]).transpose(2, 0, 1))
+        if max(gaps.min(axis=1).max(), gaps.min(axis=0).max()) <= element_size:
+            out.add(max((a, b), key=lambda edge: (edge.length, edge.origin)).origin)
+    return frozenset(out)
+
+
 def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_free,
             worst_allowed, stop_at_free, last_resort, state):
     """blocks_and_mesh's partitions and rebuilds, with or without cutting hexagons;
@@ -400,6 +419,12 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
         partition = build_partition(domain, lines, background.element_size, cuts, dissolve,
                                     background.flat_joints, background.feature_corners,
                                     last_resort)
+        twins = _twin_lines(partition, background.element_size) - dissolve
+        if twins:  # one of each pair goes, before anything else is decided
+            dissolve = dissolve | twins
+            partition = build_partition(domain, lines, background.element_size, cuts,
+                                        dissolve, background.flat_joints,
+                                        background.feature_corners, last_resort)
         partition = free_blocks(partition, [k for k in range(len(partition.blocks))
                                             if _block_key(partition, k) in freed],
                                 "a block map gives a degenerate element")
