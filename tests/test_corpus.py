@@ -22,7 +22,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"occt_face2", "ventilator_hub"}
 # Partly in blocks: some faces of the partition get unstructured quads (free faces).
-PARTLY_BLOCKS = {"perforated_plate", "blend_horn_plate", "blend_sawtooth", "blend_scallop_slots"}
+PARTLY_BLOCKS = {"perforated_plate", "blend_sawtooth", "blend_scallop_slots"}
 NO_BLOCKS_YET = PARTLY_BLOCKS
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 

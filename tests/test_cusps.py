@@ -93,3 +93,30 @@ def test_a_tangent_horns_kite_sits_where_the_horn_is_half_an_element_wide(diviso
     result = mesh_domain(domain, size=None if divisor is None else diameter(domain) / divisor)
     assert result.structured_share == 1.0, result.problem
     assert result.quality["min_scaled_jacobian"] > 0.1
+
+
+def test_the_line_from_a_tangent_horns_tip_keeps_to_its_middle():
+    # blend_horn_plate's horns: a line x = 10 and a circle of radius 6 about (16, 150)
+    # (and about (16, 0)), tangent at the tips.  Traced along the field from the tip,
+    # the line drifted onto the straight side and ran along it to a corner, leaving a
+    # two-cornered sliver beside it (98 % of the part in blocks); it now follows the
+    # horn's middle while the horn is narrower than 1.5 elements, and every face is a block.
+    from pathlib import Path
+
+    from quadcnn_wb.core.input.load import load_domain
+
+    domain = load_domain(Path(__file__).parent / "corpus" / "blend_horn_plate.brep")
+    result = mesh_domain(domain)
+    assert result.structured_share == 1.0, result.problem
+    seen = 0
+    for line in result.reference.streamlines:
+        if line.start.kind == line.end.kind == "boundary":
+            continue  # a kite's arms, which cross the horn from side to side
+        for tip_y in (150.0, 0.0):
+            points = np.asarray(line.points)
+            near = points[(np.abs(points[:, 1] - tip_y) < 3.8) & (points[:, 0] < 13.0)]
+            to_line = near[:, 0] - 10.0
+            to_arc = np.hypot(near[:, 0] - 16.0, near[:, 1] - tip_y) - 6.0
+            assert np.all(np.minimum(to_line, to_arc) > 0.4 * (to_line + to_arc))
+            seen += len(near)
+    assert seen >= 8

@@ -38,7 +38,8 @@ ARM_LEAN = math.radians(60)  # between an arm and the direction from M back to t
 ARM_POINTS = 4  # polyline points per arm
 SEARCH = 3.0  # reaches along each side searched for the point nearest M
 SEARCH_SAMPLES = 600
-TIP_START = 0.5  # background sizes from a cusp's tip to where a line traced from it starts
+MIDLINE_STEP = 0.25  # background sizes between the points of a line from a cusp's tip ...
+MIDLINE_WIDTH = 1.5  # ... that follows the horn's middle while it is narrower than this
 TANGENT_TIP = math.radians(0.5)  # a cusp this sharp is a horn between tangent curves ...
 HORN_WIDTH = 0.5  # ... whose kite sits where the horn is this many sizes wide ...
 HORN_SEARCH = 6.0  # ... looked for this many sizes in
@@ -106,8 +107,9 @@ def _lines_at(lines, node) -> list:
 
 
 def _from_tip(domain, background, field, lines, node) -> list:
-    """A line traced from the cusp at ``node`` along its bisector, stopped where it first
-    crosses one of ``lines`` (a T-junction there), as the motorcycle graph stops traces."""
+    """A line from the cusp at ``node`` along the horn's middle and then the field (along
+    its bisector where the horn is wide from the tip on), stopped where it first crosses
+    one of ``lines`` (a T-junction there), as the motorcycle graph stops traces."""
     corner = corner_endpoint(background, node)
     si, t = corner.segment, corner.param
     loop = domain.loops[corner.loop]
@@ -121,18 +123,15 @@ def _from_tip(domain, background, field, lines, node) -> list:
     h = background.element_size
     tris = np.nonzero((background.triangles == node).any(axis=1))[0]
     start = start_triangle(background.walker, tris, tip, bisector, h)
-    # Between tangent curves the bisector runs along both sides, on the boundary; the
-    # trace leaves from the middle of the horn a little way in (halfway between the
-    # sides' points TIP_START sizes from the tip), which lies inside whatever the sign
-    # of round-off.
-    a, b, _ = _horn_sides(loop, (si, t), TIP_START * h, 1)
-    inside = 0.5 * (a[-1] + b[-1])
-    lean = float(np.hypot(*(inside - tip)))
-    if lean > 0.0:
-        heading = (inside - tip) / lean
-        (line,) = integrate(domain, background, field, [(inside, heading, start, corner)])
-        line = dataclasses.replace(line, points=np.vstack([tip, line.points]))
-    else:
+    # Between tangent curves the bisector runs along both sides, on the boundary, and the
+    # field in a horn narrower than an element says little (a trace from the middle of
+    # 0042's horn drifted onto one side and ran along it to a corner, and the two faces
+    # it left were a two-cornered sliver and a kite's neighbour of three corners).  So
+    # the line follows the horn's middle (halfway between the sides' points at equal arc
+    # lengths from the tip, which lies inside whatever the sign of round-off) until the
+    # sides are MIDLINE_WIDTH sizes apart, and the field from there.
+    line = _along_middle(domain, background, field, corner, start)
+    if line is None:
         (line,) = integrate(domain, background, field, [(tip, bisector, start, corner)])
     every = list(lines) + [line]
     new = len(lines)
@@ -150,6 +149,41 @@ def _from_tip(domain, background, field, lines, node) -> list:
             line, points=np.vstack([pts[cum < s], point_at(pts, cum, s)]),
             end=Endpoint("streamline", j, param=float(s_j / other)))
     return [line]
+
+
+def _along_middle(domain, background, field, corner, start):
+    """The line from the cusp at ``corner`` along the horn's middle, then the field
+    (see _from_tip); None where the horn is wide from the tip on, or its middle leaves
+    the background (``start``: the tip's triangle the line goes into)."""
+    tip = background.nodes[corner.index]
+    middle = _midline(domain.loops[corner.loop], (corner.segment, corner.param),
+                      background.element_size)
+    if not len(middle):
+        return None
+    walk = start
+    for point in middle:  # point by point: a curved horn's chord may leave the domain
+        found, _, _ = background.walker.locate(np.array([walk]), point[None])
+        if found[0] < 0:
+            return None
+        walk = int(found[0])
+    ahead = middle[-1] - (middle[-2] if len(middle) > 1 else tip)
+    if not np.hypot(*ahead) > 0:
+        return None
+    (line,) = integrate(domain, background, field,
+                        [(middle[-1], ahead / np.hypot(*ahead), walk, corner)])
+    return dataclasses.replace(line, points=np.vstack([tip, middle[:-1], line.points]))
+
+
+def _midline(loop, tip, h) -> np.ndarray:
+    """Points halfway between the two sides of the cusp at ``tip`` (segment, parameter),
+    one every MIDLINE_STEP sizes of arc length along both, out to where the sides are
+    MIDLINE_WIDTH sizes apart (at most HORN_SEARCH sizes out); empty where even the
+    first pair is that far apart."""
+    samples = int(round(HORN_SEARCH / MIDLINE_STEP))
+    a, b, _ = _horn_sides(loop, tip, HORN_SEARCH * h, samples)
+    keep = np.hypot(*(a - b).T) < MIDLINE_WIDTH * h
+    count = int(np.argmin(keep)) if not keep.all() else len(keep)
+    return 0.5 * (a[:count] + b[:count])
 
 
 def _horn_reach(domain, background, node, size) -> float:
