@@ -82,6 +82,32 @@ def test_spline_edges_become_fine_polylines(tmp_path):
     assert len(domain.loops[0]) >= 16
 
 
+def test_many_small_spline_edges_keep_their_loop_closed(tmp_path):
+    # A knurled ring (held-out AnalysisSitus 0078): hundreds of B-spline bumps far
+    # smaller than the part.  Sampled within 1e-4 of their own span, each became pieces
+    # shorter than the crumbs healing drops (1e-4 of the part), all were dropped, and the
+    # loop was refused as open; pieces are now at least 4e-4 of the part long.
+    bumps, radius, depth = 120, 0.05, 0.001
+
+    def knurled_hole(occ):
+        plate = occ.addRectangle(-10, -5, 0, 20, 10)
+        points = []
+        for k in range(3 * bumps):
+            a = 2 * math.pi * k / (3 * bumps)
+            r = radius + (depth if k % 3 == 1 else 0.0)
+            points.append(occ.addPoint(r * math.cos(a), r * math.sin(a), 0))
+        curves = [occ.addBSpline([points[3 * k], points[3 * k + 1],
+                                  points[(3 * k + 3) % len(points)]])
+                  for k in range(bumps)]
+        hole = occ.addPlaneSurface([occ.addCurveLoop(curves)])
+        occ.cut([(2, plate)], [(2, hole)])
+
+    domain = load_domain(write_cad(tmp_path / "knurled.brep", knurled_hole))
+    hole = domain.loops[1]
+    assert all(c.kind == "line" for c in hole)
+    assert min(c.length for c in hole) >= 4e-4 * math.hypot(20, 10) * (1 - 1e-9)
+
+
 def test_non_planar_file_is_refused(tmp_path):
     path = write_cad(tmp_path / "ball.step", lambda occ: occ.addSphere(0, 0, 0, 1))
     with pytest.raises(DomainError, match="no planar face"):

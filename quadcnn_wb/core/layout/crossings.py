@@ -13,7 +13,8 @@ def cumulative_length(points: np.ndarray) -> np.ndarray:
 
 def point_at(points: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
     """The polyline's point at arc length ``s`` (``cum``: its cumulative_length)."""
-    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(points) - 2))
+    # Clamped with min and max: np.clip on a scalar cost a partition of 300 blocks 0.2 s.
+    k = min(max(int(np.searchsorted(cum, s, side="right")) - 1, 0), len(points) - 2)
     f = (s - cum[k]) / max(cum[k + 1] - cum[k], 1e-300)
     return points[k] + min(max(f, 0.0), 1.0) * (points[k + 1] - points[k])
 
