@@ -116,8 +116,8 @@ FINE_TOO_SLOW = {"perforated_plate"}
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
 # against 12; gmsh alg. 11 has 387 and 144).
 FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19"}
-# Free faces there too (blend_sawtooth: 0.95 of it in blocks; occt_face2: 0.95).
-FINE_PARTLY_BLOCKS = {"blend_sawtooth", "occt_face2"}
+# Free faces there too (blend_sawtooth: 0.95 of it in blocks).
+FINE_PARTLY_BLOCKS = {"blend_sawtooth"}
 
 
 @pytest.mark.parametrize("name", [

@@ -134,3 +134,51 @@ def test_healing_is_reported_on_the_command_line(write_json, tmp_path):
     data = json.loads(out.read_text())
     assert data["healed"] == ["loop 1: 1 joint(s) between arcs of one circle merged"]
     assert data["structured_share"] == 1.0
+
+
+def _notched_plate_with_split_edges(start: int, reverse: bool) -> dict:
+    """A plate whose bottom edge is stored as three collinear lines and whose top carries a
+    small round notch stored as 40 short lines, each joint of which is collinear within
+    the healing tolerance; the loop starts at piece ``start`` and may run backwards."""
+    notch = [[50 + 2 * math.cos(a), 60 - 2 * math.sin(a)]
+             for a in (math.pi * k / 40 for k in range(41))]
+    points = [[0, 0], [30, 0], [70, 0], [100, 0], [100, 60], *notch, [0, 60]]
+    loop = [L(p, q) for p, q in zip(points, points[1:] + points[:1])]
+    if reverse:
+        loop = [L(s["line"][1], s["line"][0]) for s in reversed(loop)]
+    return {"loops": [loop[start:] + loop[:start]]}
+
+
+def _vertices(domain) -> set:
+    return {tuple(round(float(x), 9) for x in c.p0) for c in domain.loops[0]}
+
+
+@pytest.mark.parametrize("start,reverse", [(0, False), (2, False), (20, False), (7, True)])
+def test_a_run_of_lines_keeps_its_shape_from_any_start(start, reverse):
+    # Judged joint by joint, each of the notch's joints bows out by less than the healing
+    # tolerance; merged one after another they became chords across the notch, and which
+    # ones depended on where the loop started.  Now the split edge becomes one line, the
+    # notch keeps every given vertex within the tolerance, and the start does not matter.
+    given = _notched_plate_with_split_edges(start, reverse)
+    domain = domain_from_json(given)
+    vertices = _vertices(domain)
+    assert (30.0, 0.0) not in vertices and (70.0, 0.0) not in vertices
+    assert 4 + 3 < len(vertices) < 4 + 41  # the notch simplified, not flattened
+    tol = HEAL_TOL * domain.size
+    for segment in given["loops"][0]:
+        x, y = segment["line"][0]
+        assert min(_distance_to(c, x, y) for c in domain.loops[0]) <= tol
+    assert vertices == _vertices(domain_from_json(_notched_plate_with_split_edges(0, False)))
+
+
+def _distance_to(line, x, y) -> float:
+    d = line.p1 - line.p0
+    t = min(1.0, max(0.0, ((x - line.p0[0]) * d[0] + (y - line.p0[1]) * d[1]) / (d @ d)))
+    return math.hypot(x - line.p0[0] - t * d[0], y - line.p0[1] - t * d[1])
+
+
+def test_healing_a_healed_loop_changes_nothing():
+    healed = domain_from_json(_notched_plate_with_split_edges(5, False))
+    again = domain_from_json(healed.to_json())
+    assert again.healed == ()
+    assert _vertices(again) == _vertices(healed)

@@ -19,7 +19,10 @@ CORNER_MIN_TURN = 1e-4  # radians; smaller tangent breaks are smooth joins, not 
 QUARTER_TIE = 1e-6  # quarter turns: angles this close to an odd multiple of 45° are that tie
 
 
-REVERSAL = 1e-6  # radians: a tangent that turns back this nearly is read by the curves
+# radians: a tangent that turns back this nearly is read by the curves.  Not round-off
+# only: CAD kernels keep tangent curves tangent to about 1e-5 (a crank web's horn, two
+# B-splines meeting at a cusp, turned back by 1e-5 the wrong way and read as a notch).
+REVERSAL = 1e-3
 REVERSAL_PROBE = 0.05  # ... a point this share of the shorter curve from the joint
 
 

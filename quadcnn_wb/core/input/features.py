@@ -73,7 +73,9 @@ SLOT_END = 1.0  # element sizes: ... unless its radius is under this (a narrow s
 SLOT_SWEEP = math.radians(200)  # ... turning at most this
 CONVEX_ROUND = 1.0  # element sizes: so is a convex fillet of a smaller radius
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
-JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint
+JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint,
+JOINT_GAP = 1e-6  # ... and so is one this close in element sizes (a cut there would leave
+#                   gmsh a curve too short to draw)
 # A joint turning less is a smooth join.  Not a round number of degrees: a regular polygon
 # of 24, 30 or 36 sides turns by 15°, 12° or 10°, and which side of the rule such a
 # polyline falls on must not hang on round-off.
@@ -264,9 +266,10 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     middle = (start + 0.5 * (end - start)) % total
     seg = int(np.clip(np.searchsorted(offsets, middle, side="right") - 1, 0, len(loop) - 1))
     param = (middle - offsets[seg]) / loop[seg].length
-    if param >= 1.0 - JOINT_TOL:
+    near = max(JOINT_TOL, JOINT_GAP * size / loop[seg].length)
+    if param >= 1.0 - near:
         seg, param = (seg + 1) % len(loop), 0.0
-    elif param <= JOINT_TOL:
+    elif param <= near:
         param = 0.0
     flat = quarters == 2
     joints = tuple(si for si in inside if flat or not (param == 0.0 and si == seg))

@@ -62,62 +62,132 @@ def report_gaps(loops, eps: float, notes: list) -> None:
 
 
 def merge_curves(loop, li: int, tol: float, notes: list) -> list:
-    """Consecutive arcs of one circle and consecutive collinear lines as one curve; a
-    loop of arcs of one circle that closes becomes that circle."""
+    """Runs of arcs of one circle and runs of collinear lines as one curve each; a loop of
+    arcs of one circle that closes becomes that circle.
+
+    Every joint is judged on the curves as given and a run is merged whole or not at all,
+    so the result does not hang on where the loop starts or which way it runs (a mirrored
+    copy heals alike), and healing a healed loop changes nothing.  A run of lines merges
+    only when all its inner vertices lie within ``tol`` of the line that replaces it:
+    judged joint by joint, a finely sampled curve (a knurled hole stored as short lines)
+    passes everywhere and would collapse onto its chord."""
     curves = list(loop)
-    merged_arcs = merged_lines = 0
-    changed = True
-    while changed and len(curves) > 1:
-        changed = False
-        for k in range(len(curves)):
-            a, b = curves[k], curves[(k + 1) % len(curves)]
-            joined = _join(a, b, tol)
-            if joined is None:
-                continue
-            if isinstance(a, Arc):
-                merged_arcs += 1
-            else:
-                merged_lines += 1
-            if k + 1 < len(curves):
-                curves[k:k + 2] = [joined]
-            else:  # the last and the first: the loop now starts where the last one did
-                curves = [joined] + curves[1:-1]
-            changed = True
-            break
-    if len(curves) == 1 and isinstance(curves[0], Arc) and not curves[0].is_full:
-        curves = [_close_circle(curves[0])]
-    if merged_arcs:
-        notes.append(f"loop {li}: {merged_arcs} joint(s) between arcs of one circle merged")
-    if merged_lines:
-        notes.append(f"loop {li}: {merged_lines} joint(s) of collinear lines merged")
-    return curves
+    n = len(curves)
+    if n == 1 and isinstance(curves[0], Arc) and not curves[0].is_full:
+        return [_close_circle(curves[0])]
+    if n < 2:
+        return curves
+    joins = [_continues(curves[k], curves[(k + 1) % n], tol) for k in range(n)]
+    if all(joins):
+        whole = _whole_circle(curves, tol)
+        if whole is None:
+            return curves  # no break between runs: not a circle, so left to validation
+        notes.append(f"loop {li}: {n - 1} joint(s) between arcs of one circle merged")
+        return [whole]
+    first = (joins.index(False) + 1) % n  # runs start after a joint that stays
+    runs, run = [], []
+    for k in range(n):
+        i = (first + k) % n
+        run.append(i)
+        if not joins[i]:
+            runs.append(run)
+            run = []
+    pieces, merged = [], {"arc": 0, "line": 0}
+    for run in runs:
+        given = [curves[i] for i in run]
+        pieces.append(_merge_run(given, tol) if len(given) > 1 else given)
+        merged[given[0].kind] += len(given) - len(pieces[-1])
+    first_run = next(k for k, run in enumerate(runs) if 0 in run)  # keep the loop's start
+    out = [c for piece in pieces[first_run:] + pieces[:first_run] for c in piece]
+    if merged["arc"]:
+        notes.append(f"loop {li}: {merged['arc']} joint(s) between arcs of one circle merged")
+    if merged["line"]:
+        notes.append(f"loop {li}: {merged['line']} joint(s) of collinear lines merged")
+    return out
 
 
-def _join(a, b, tol: float):
-    """One curve for a followed by b, or None when they are not parts of one curve."""
+def _continues(a, b, tol: float) -> bool:
+    """Whether b carries on a's curve: both lines, same way, their joint within ``tol``
+    of the line from a's start to b's end; or arcs of one circle turning the same way."""
     if isinstance(a, Line) and isinstance(b, Line):
-        da, db = a.p1 - a.p0, b.p1 - b.p0
-        if float(np.dot(da, db)) <= 0.0:
-            return None
-        whole = Line(a.p0, b.p1)
-        if abs(cross2(b.p1 - a.p0, a.p1 - a.p0)) / whole.length > tol:
-            return None
-        return whole
+        if float(np.dot(a.p1 - a.p0, b.p1 - b.p0)) <= 0.0:
+            return False
+        return _off_line(a.p1, a.p0, b.p1) <= tol
     if isinstance(a, Arc) and isinstance(b, Arc):
         if a.is_full or b.is_full or (a.sweep > 0) != (b.sweep > 0):
-            return None
-        if np.hypot(*(a.center - b.center)) > tol or abs(a.radius - b.radius) > tol:
-            return None
-        sweep = a.sweep + b.sweep
-        if abs(sweep) > TWO_PI + tol / a.radius:
-            return None  # wraps over itself: an overlap for the validation to report
-        center = 0.5 * (a.center + b.center)
-        radius = 0.5 * (a.radius + b.radius)
-        a0 = math.atan2(a.p0[1] - center[1], a.p0[0] - center[0])
-        if abs(abs(sweep) - TWO_PI) <= tol / radius:
-            return _full_circle(center, radius, a.p0, sweep > 0)
-        return Arc(center, radius, a0, sweep, a.p0, b.p1)
-    return None
+            return False
+        return bool(np.hypot(*(a.center - b.center)) <= tol and abs(a.radius - b.radius) <= tol)
+    return False
+
+
+def _off_line(p, a, b) -> float:
+    """Distance of p from the line through a and b."""
+    d = b - a
+    return abs(cross2(p - a, d)) / float(np.hypot(*d))
+
+
+def _merge_run(run, tol: float) -> list:
+    """The curves that replace a run of curves each continuing the one before: arcs of one
+    circle become one arc (unless they wrap round: an overlap for the validation to
+    report); lines keep only the vertices needed to stay within ``tol`` of every given
+    vertex (Douglas-Peucker), so a finely sampled curve keeps its shape."""
+    if isinstance(run[0], Line):
+        points = [run[0].p0] + [c.p1 for c in run]
+        kept = _kept_vertices(points, tol)
+        return [Line(points[i], points[j]) for i, j in zip(kept, kept[1:])]
+    center = np.mean([c.center for c in run], axis=0)
+    radius = float(np.mean([c.radius for c in run]))
+    sweep = float(sum(c.sweep for c in run))
+    if abs(sweep) >= TWO_PI - tol / radius:
+        return list(run)
+    a0 = math.atan2(run[0].p0[1] - center[1], run[0].p0[0] - center[0])
+    return [Arc(center, radius, a0, sweep, run[0].p0, run[-1].p1)]
+
+
+TIE = 1e-9  # vertices this close (relative) to the farthest one are kept with it
+
+
+def _kept_vertices(points, tol: float) -> list:
+    """Indices of the polyline vertices that keep it within ``tol`` of all of them: the
+    ends, then recursively the farthest vertex from each chord while it is beyond
+    ``tol``.  Vertices tied for farthest are all kept, so a symmetric run keeps a
+    symmetric set whichever way it is walked."""
+    pts = np.asarray(points, dtype=float)
+    kept = {0, len(pts) - 1}
+    spans = [(0, len(pts) - 1)]
+    while spans:
+        i, j = spans.pop()
+        if j - i < 2:
+            continue
+        d = _off_segment(pts[i + 1:j], pts[i], pts[j])
+        far = float(d.max())
+        if far <= tol:
+            continue
+        cuts = [i] + [i + 1 + k for k in np.flatnonzero(d >= far * (1.0 - TIE))] + [j]
+        kept.update(cuts)
+        spans.extend(zip(cuts, cuts[1:]))
+    return sorted(kept)
+
+
+def _off_segment(points, a, b) -> np.ndarray:
+    """Distances of points from the segment a-b."""
+    d = b - a
+    length2 = float(d @ d)
+    t = np.zeros(len(points)) if length2 == 0.0 else np.clip((points - a) @ d / length2, 0, 1)
+    return np.hypot(*(points - (a + t[:, None] * d)).T)
+
+
+def _whole_circle(curves, tol: float):
+    """The circle a loop of arcs of one circle closes into, or None."""
+    if not isinstance(curves[0], Arc):
+        return None
+    radius = float(np.mean([c.radius for c in curves]))
+    sweep = float(sum(c.sweep for c in curves))
+    if abs(sweep) > TWO_PI + tol / radius:
+        return None  # wraps round more than once: an overlap
+    # (short of a full turn only by crumbs dropped before: the loop was checked closed)
+    center = np.mean([c.center for c in curves], axis=0)
+    return _full_circle(center, radius, curves[0].p0, sweep > 0)
 
 
 def _close_circle(arc: Arc) -> Arc:

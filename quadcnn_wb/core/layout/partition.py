@@ -39,7 +39,8 @@ from .subdivide import split_odd_faces
 
 TURN_TIE = 1e-6  # radians: turns this close to CORNER_TURN are exactly at it
 CORNER_TURN = math.radians(45)  # a face turning more than this at a vertex has a corner there
-PROMOTED_TURN = math.radians(20)  # a three-cornered face's fourth corner bends at least this
+PROMOTED_TURN = math.radians(15)  # a three-cornered face's fourth corner bends at least this
+# (tailwheel_gusset's spike ends in a slightly curved chamfer: 16.6° at its upper end)
 # The last resort (build_partition's ``last_resort``): faces of up to this many corners,
 # and faces with reflex corners that turn back by at most STAR_REFLEX, are split round a
 # centre (subdivide.py) instead of being left free.
