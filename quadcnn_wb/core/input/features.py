@@ -74,7 +74,7 @@ SLOT_SWEEP = math.radians(200)  # ... turning at most this
 CONVEX_ROUND = 1.0  # element sizes: so is a convex fillet of a smaller radius
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint,
-JOINT_GAP = 1e-6  # ... and so is one this close in element sizes (a cut there would leave
+JOINT_GAP = 1e-3  # ... and so is one this close in element sizes (a cut there would leave
 #                   gmsh a curve too short to draw)
 # A joint turning less is a smooth join.  Not a round number of degrees: a regular polygon
 # of 24, 30 or 36 sides turns by 15°, 12° or 10°, and which side of the rule such a
