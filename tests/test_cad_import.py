@@ -154,3 +154,22 @@ def test_corrupt_files_are_refused(tmp_path, content, message):
 def test_missing_file(tmp_path):
     with pytest.raises(DomainError, match="no such file"):
         load_domain(tmp_path / "nothing.step")
+
+
+def test_a_spline_whose_derivative_vanishes_at_its_ends_imports_cleanly(tmp_path):
+    # Doubled end control points: the B-spline's derivative is zero at both ends, so
+    # the biarcs take their end tangents from the samples (a zero tangent gave NaN arcs).
+    import warnings
+
+    def flap(occ):
+        a, b, c = occ.addPoint(0, 0, 0), occ.addPoint(10, 0, 0), occ.addPoint(10, 5, 0)
+        inner = [occ.addPoint(4, 6, 0), occ.addPoint(2, 3, 0)]
+        spline = occ.addBSpline([c, c, *inner, a, a])
+        occ.addPlaneSurface([occ.addCurveLoop([occ.addLine(a, b), occ.addLine(b, c), spline])])
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        domain = load_domain(write_cad(tmp_path / "flap.brep", flap))
+    loop = domain.loops[0]
+    assert all(np.all(np.isfinite(c.p0)) for c in loop) and domain.area > 0
+    assert any(c.kind == "arc" for c in loop)

@@ -3,8 +3,9 @@
 A sketch's closed wires become a face (holes nested by FreeCAD's bullseye face maker); a
 face is taken as it is.  Coordinates go into the face's own plane (the sketch's placement
 for sketches), so the mesher sees a 2D domain; results go back through the same placement.
-Lines and circular arcs stay exact; B-splines, ellipses and other curves become polylines
-within CURVE_TOLERANCE of the part size.
+Lines and circular arcs stay exact; B-splines, ellipses and other curves become arc
+splines within CURVE_TOLERANCE of the part size (core.input.arc_splines, the importer's
+rule too).
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import FreeCAD
 import numpy as np
 import Part
 
+from ..core.input.arc_splines import DENSE, arc_spline
+from ..core.input.cad_import import MIN_PIECE
 from ..core.input.curves import Arc, Line
 from ..core.input.domain import DomainError, make_domain
 
@@ -92,16 +95,20 @@ def face_to_domain(face, placement, label="face", units="mm"):
             raise DomainError(f"{label}: the face is not planar")
         return (p.x, p.y)
 
+    def local_direction(v):
+        d = inverse.Rotation.multVec(v)
+        return (d.x, d.y)
+
     loops = []
     for wire in [face.OuterWire] + [w for w in face.Wires if not w.isSame(face.OuterWire)]:
         loop = []
         for edge in wire.OrderedEdges:
-            loop.extend(_edge_pieces(edge, local, tol, size))
+            loop.extend(_edge_pieces(edge, local, local_direction, tol, size))
         loops.append(_chain(loop))
     return make_domain(loops, units=units)
 
 
-def _edge_pieces(edge, local, tol, size):
+def _edge_pieces(edge, local, local_direction, tol, size):
     curve = edge.Curve
     first, last = edge.FirstParameter, edge.LastParameter
     start, end = local(edge.valueAt(first)), local(edge.valueAt(last))
@@ -113,12 +120,12 @@ def _edge_pieces(edge, local, tol, size):
             return [Arc.circle(np.array(c), curve.Radius)]
         mid = local(edge.valueAt(0.5 * (first + last)))
         return [(np.array(start), np.array(mid), np.array(end))]
-    points = [local(p) for p in edge.discretize(Deflection=CURVE_TOLERANCE * size)]
-    if edge.isClosed() and len(points) > 2 and np.hypot(*np.subtract(points[0], points[-1])) \
-            <= tol:
+    us = np.linspace(first, last, DENSE + 1)
+    points = np.array([local(edge.valueAt(u)) for u in us])
+    if edge.isClosed() and np.hypot(*(points[0] - points[-1])) <= tol:
         points[-1] = points[0]
-    return [Line(np.array(a), np.array(b)) for a, b in zip(points[:-1], points[1:])
-            if np.hypot(*np.subtract(a, b)) > tol]
+    tangents = np.array([local_direction(edge.derivative1At(u)) for u in us])
+    return arc_spline(points, tangents, CURVE_TOLERANCE * size, MIN_PIECE * size)
 
 
 def _chain(pieces):

@@ -159,6 +159,26 @@ class TestQuadMeshDocument(unittest.TestCase):
         area = sum(f.Area for f in mesh.BlockFaces.Shape.Faces)
         self.assertAlmostEqual(area / (3.141592653589793 * 30 * 12), 1.0, delta=0.01)
 
+    def test_a_bspline_edge_becomes_tangent_arcs_as_the_importer_makes_them(self):
+        # The same rule as STEP/BREP input (core.input.arc_splines): no polyline kinks.
+        from quadcnn_wb.core.input.corners import interior_angle, is_corner
+        from quadcnn_wb.freecad.geometry import face_to_domain
+
+        spline = Part.BSplineCurve()
+        spline.interpolate([V(40, 0, 0), V(34, 9, 0), V(20, 14, 0), V(6, 9, 0), V(0, 0, 0)])
+        wire = Part.Wire([Part.LineSegment(V(0, 0, 0), V(40, 0, 0)).toShape(),
+                          spline.toShape()])
+        placement = FreeCAD.Placement(V(10, -5, 3), FreeCAD.Rotation(V(1, 1, 0), 30))
+        face = Part.Face(wire)
+        face.Placement = placement
+        domain = face_to_domain(face, placement)
+        loop = domain.loops[0]
+        arcs = [c for c in loop if c.kind == "arc"]
+        self.assertGreaterEqual(len(arcs), 2)
+        joints = [interior_angle(loop[k - 1], loop[k]) for k in range(len(loop))]
+        self.assertEqual(sum(is_corner(a) for a in joints), 2)  # the line's two ends only
+        self.assertAlmostEqual(domain.area / face.Area, 1.0, delta=1e-4)
+
 
 class TestSketchInBody(unittest.TestCase):
     def test_sketch_inside_a_placed_body_meshes_in_global_coordinates(self):
