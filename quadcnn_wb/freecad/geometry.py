@@ -16,7 +16,7 @@ import Part
 
 from ..core.input.arc_splines import DENSE, arc_spline
 from ..core.input.cad_import import MIN_PIECE
-from ..core.input.curves import Arc, Line
+from ..core.input.curves import Arc, Line, diameter_of
 from ..core.input.domain import DomainError, make_domain
 
 CURVE_TOLERANCE = 1e-4  # chordal deviation for curves that are not lines or arcs (x size)
@@ -86,7 +86,7 @@ def _plane_placement(face, label):
 def face_to_domain(face, placement, label="face", units="mm"):
     """Domain in the plane's local coordinates; checks the face lies in that plane."""
     inverse = placement.inverse()
-    size = face.BoundBox.DiagonalLength
+    size = _size_in_plane(face, inverse)
     tol = max(1e-7 * size, 1e-12)
 
     def local(v):
@@ -106,6 +106,17 @@ def face_to_domain(face, placement, label="face", units="mm"):
             loop.extend(_edge_pieces(edge, local, local_direction, tol, size))
         loops.append(_chain(loop))
     return make_domain(loops, units=units)
+
+
+def _size_in_plane(face, inverse) -> float:
+    """The face's diameter in its plane, from its edges sampled at fixed parameters: the
+    same for a sketch in any placement (the global bounding box's diagonal is not)."""
+    points = []
+    for edge in face.Edges:
+        for u in np.linspace(edge.FirstParameter, edge.LastParameter, 9):
+            p = inverse.multVec(edge.valueAt(float(u)))
+            points.append((p.x, p.y))
+    return diameter_of(points)
 
 
 def _edge_pieces(edge, local, local_direction, tol, size):

@@ -11,7 +11,6 @@ nodes impossible (no fewer than 3978).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import gmsh
@@ -19,7 +18,7 @@ import numpy as np
 
 from ..gmsh_session import gmsh_session, silenced_stdio
 from .arc_splines import DENSE, arc_spline
-from .curves import Arc, Line, circumcenter
+from .curves import Arc, Line, circumcenter, diameter_of
 from .domain import DomainError, make_domain
 
 CURVE_TOLERANCE = 1e-4  # chordal deviation allowed for curves that are not lines or arcs
@@ -59,8 +58,7 @@ def read_cad_face(path) -> object:
                               f"{gmsh.model.getType(2, faces[0])} surface)")
         face = planar[0]
         frame = _plane_frame(face)
-        x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(2, face)
-        shortest = MIN_PIECE * math.sqrt((x1 - x0) ** 2 + (y1 - y0) ** 2 + (z1 - z0) ** 2)
+        shortest = MIN_PIECE * _face_size(face, frame)
         loops = _face_loops(face, frame, shortest)
     loops.sort(key=lambda loop: -_extent(loop))  # holes lie inside: the outer loop is widest
     return make_domain(loops, units="mm")
@@ -98,6 +96,19 @@ def _to_plane(frame, xyz) -> np.ndarray:
     return np.stack([d @ ex, d @ ey], axis=-1)
 
 
+def _face_size(face: int, frame) -> float:
+    """The face's diameter, from its curves sampled at fixed parameters: the pieces' scale
+    must not hang on the part's pose (a bounding box's diagonal does, and a crank web
+    turned by 37° got other pieces than in its own pose)."""
+    _, curve_lists = gmsh.model.occ.getCurveLoops(face)
+    points = []
+    for tag in {abs(int(t)) for tags in curve_lists for t in tags}:
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        us = np.linspace(float(lo[0]), float(hi[0]), 9)
+        points.append(_to_plane(frame, gmsh.model.getValue(1, tag, list(us))))
+    return diameter_of(np.vstack(points))
+
+
 def _face_loops(face: int, frame, shortest: float) -> list:
     _, curve_lists = gmsh.model.occ.getCurveLoops(face)
     loops = []
@@ -119,7 +130,7 @@ def _curve_pieces(tag: int, frame, shortest: float) -> list:
         return _to_plane(frame, gmsh.model.getValue(1, tag, list(us)))
 
     probe = at(np.linspace(u0, u1, 33))
-    span = float(np.ptp(probe, axis=0).max())
+    span = diameter_of(probe)  # (a turned copy's too: not its bounding box)
     tol = EXACT_TOLERANCE * max(span, 1e-300)
     closed = np.hypot(*(probe[-1] - probe[0])) <= 1e-9 * max(span, 1e-300)
     chord = probe[-1] - probe[0]

@@ -244,3 +244,17 @@ def winding_numbers(loop, points: np.ndarray) -> np.ndarray:
                 inside &= cross * cross2(c.p1 - c.p0, c.midpoint() - c.p0) > 0.0
             total += np.where(inside, TWO_PI if c.sweep > 0 else -TWO_PI, 0.0)
     return np.rint(total / TWO_PI).astype(int)
+
+
+def diameter_of(points) -> float:
+    """The largest distance between two of the points: a size that a turned, moved or
+    mirrored copy shares (a bounding box's is not)."""
+    pts = np.unique(np.asarray(points, dtype=float).reshape(-1, 2), axis=0)
+    if len(pts) > 3:
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            pts = pts[ConvexHull(pts).vertices]
+        except QhullError:
+            pass  # all on one line: every point is a candidate
+    return float(np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1).max()))

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .curves import Arc, Line, curve_bbox, loop_signed_area, winding_number
+from .curves import Arc, Line, curve_bbox, diameter_of, loop_signed_area, winding_number
 from .healing import HEAL_TOL, drop_crumbs, merge_curves, report_gaps
 from .intersections import Overlap, curve_intersections
 
@@ -179,15 +179,7 @@ def _raw_size(loops) -> float:
     for loop in loops:
         for c in loop:
             pts.extend(c if isinstance(c, tuple) else c.point(t))
-    pts = np.unique(np.array(pts, dtype=float), axis=0)
-    if len(pts) > 3:
-        from scipy.spatial import ConvexHull, QhullError
-
-        try:
-            pts = pts[ConvexHull(pts).vertices]
-        except QhullError:
-            pass  # all on one line: every point is a candidate
-    size = float(np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1).max()))
+    size = diameter_of(pts)
     if size == 0.0:
         raise DomainError("the domain has zero area (all its points coincide)")
     return size
