@@ -1,0 +1,177 @@
+"""Every part in a folder, meshed at the default size and at diameter / 100.
+
+    python -m quadcnn_wb.bench.folder DIR [--rows ROWS.jsonl] [--compare EARLIER.jsonl]
+                                          [--time-limit S] [--names NAME ...]
+
+For faces nobody here wrote (a user's own parts, a held-out set of public CAD files): each
+file (.brep .step .stp .iges .igs .json) and size runs in a fresh Python with a time limit,
+so a hang or a crash costs that row only.  One line is printed per row and one JSON line
+appended to ROWS (name, size_kind, structured_share, irregular_vertices,
+min_scaled_jacobian, quads, mesh_s, wall_s, or error); then how many rows are all in
+blocks per size.  With --compare, the rows that differ from an earlier ROWS file (share,
+irregular vertices, errors, or the worst scaled Jacobian by more than 0.01) are listed:
+what a change did to parts the tests do not hold.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import traceback
+from pathlib import Path
+
+SUFFIXES = {".brep", ".step", ".stp", ".iges", ".igs", ".json"}
+SIZES = ("default", "d100")
+MARK = "@@ROW@@ "
+SJ_CHANGE = 0.01  # a worst scaled Jacobian that moves by more is a difference
+
+
+def worker(path: str, kind: str) -> int:
+    """In the subprocess: mesh one file at one size, print one marked JSON row."""
+    row: dict = {}
+    try:
+        from ..core.input.load import load_domain
+        from ..core.input.pose import diameter
+        from ..core.pipeline import mesh_domain
+
+        domain = load_domain(path)
+        start = time.perf_counter()
+        if kind == "default":
+            result = mesh_domain(domain)
+        else:
+            result = mesh_domain(domain, size=diameter(domain) / 100.0)
+        row["mesh_s"] = round(time.perf_counter() - start, 3)
+        row.update({
+            "structured_share": float(result.structured_share),
+            "irregular_vertices": int(result.quality["irregular_vertices"]),
+            "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
+            "quads": int(len(result.mesh.quads)),
+        })
+    except Exception as exc:  # a refused file is a row too, with its message
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        row["traceback_tail"] = traceback.format_exc().strip().splitlines()[-3:]
+    print(MARK + json.dumps(row), flush=True)
+    return 0
+
+
+def run_one(path: Path, kind: str, limit: float) -> dict:
+    """One row, from a fresh Python killed (with its children) after ``limit`` s."""
+    row = {"name": path.stem, "size_kind": kind}
+    start = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", __spec__.name, "--worker", str(path), kind],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=limit or None)
+    except subprocess.TimeoutExpired:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.communicate()
+        row.update(wall_s=round(time.perf_counter() - start, 3), error="timeout")
+        return row
+    row["wall_s"] = round(time.perf_counter() - start, 3)
+    marked = [line for line in out.splitlines() if line.startswith(MARK)]
+    if marked:
+        row.update(json.loads(marked[-1][len(MARK):]))
+    else:
+        row["error"] = f"crash rc={proc.returncode}: " + \
+            (err.strip().splitlines() or ["(no output)"])[-1]
+    return row
+
+
+def describe(row) -> str:
+    if row is None:
+        return "(missing)"
+    if "error" in row:
+        return f"error: {row['error'][:70]}"
+    return (f"share {row['structured_share']:.3f} irr {row['irregular_vertices']} "
+            f"sj {row['min_scaled_jacobian']:.3f} quads {row['quads']}")
+
+
+def load_rows(path) -> dict:
+    """(name, size_kind) -> row; a pair written twice counts with its last row."""
+    rows = {}
+    for line in Path(path).read_text().splitlines():
+        if line.strip():
+            row = json.loads(line)
+            rows[(row["name"], row["size_kind"])] = row
+    return rows
+
+
+def differs(a, b) -> bool:
+    if a is None or b is None or ("error" in a) != ("error" in b):
+        return True
+    if "error" in a:
+        return a["error"] != b["error"]
+    return (a["structured_share"] != b["structured_share"]
+            or a["irregular_vertices"] != b["irregular_vertices"]
+            or abs(a["min_scaled_jacobian"] - b["min_scaled_jacobian"]) > SJ_CHANGE)
+
+
+def summary(rows: dict) -> list:
+    """Per size: 'KIND: all in blocks N/M (E errors)'."""
+    lines = []
+    for kind in SIZES:
+        sel = [r for (_, k), r in rows.items() if k == kind]
+        if sel:
+            full = sum(r.get("structured_share") == 1.0 for r in sel)
+            errors = sum("error" in r for r in sel)
+            lines.append(f"{kind}: all in blocks {full}/{len(sel)} ({errors} errors)")
+    return lines
+
+
+def comparison(earlier: dict, now: dict) -> list:
+    """The rows run now that differ from the earlier run, each as two lines."""
+    lines = []
+    for key in sorted(now, key=lambda nk: (nk[1], nk[0])):
+        if differs(earlier.get(key), now.get(key)):
+            lines.append(f"{key[0]:40s} {key[1]:8s} before: {describe(earlier.get(key))}")
+            lines.append(f"{'':40s} {'':8s} now:    {describe(now.get(key))}")
+    return lines
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) == 3 and argv[0] == "--worker":
+        return worker(argv[1], argv[2])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("folder", type=Path)
+    parser.add_argument("--rows", type=Path, help="append one JSON line per row here")
+    parser.add_argument("--compare", type=Path, help="an earlier --rows file")
+    parser.add_argument("--time-limit", type=float, default=300.0,
+                        help="seconds allowed to one file at one size (0: none)")
+    parser.add_argument("--names", nargs="+", help="only these files (names without suffix)")
+    args = parser.parse_args(argv)
+    files = sorted(p for p in args.folder.iterdir() if p.suffix.lower() in SUFFIXES)
+    if args.names:
+        files = [p for p in files if p.stem in set(args.names)]
+    if not files:
+        print(f"{args.folder}: no part files ({', '.join(sorted(SUFFIXES))})", file=sys.stderr)
+        return 2
+    rows = {}
+    for path in files:
+        for kind in SIZES:
+            row = run_one(path, kind, args.time_limit)
+            rows[(row["name"], kind)] = row
+            if args.rows:
+                with open(args.rows, "a") as fh:
+                    fh.write(json.dumps(row) + "\n")
+            print(f"{row['name']:40s} {kind:8s} {row['wall_s']:7.1f}s  {describe(row)}",
+                  flush=True)
+    print("\n".join(summary(rows)))
+    if args.compare:
+        lines = comparison(load_rows(args.compare), rows)
+        print(f"\n{len(lines) // 2} rows differ from {args.compare}")
+        print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

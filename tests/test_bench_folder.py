@@ -1,0 +1,43 @@
+"""The folder benchmark: every part of a folder in its own process, rows kept and compared."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+
+from conftest import REPO
+
+
+def run_folder(*args):
+    return subprocess.run([sys.executable, "-m", "quadcnn_wb.bench.folder", *map(str, args)],
+                          capture_output=True, text=True, timeout=600, cwd=REPO)
+
+
+def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_path):
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    shutil.copy(REPO / "resources" / "examples" / "l_shape.json", parts / "l_shape.json")
+    (parts / "open.json").write_text(json.dumps(
+        {"loops": [[{"line": [[0, 0], [1, 0]]}, {"line": [[1, 0], [1, 1]]}]]}))
+    (parts / "notes.txt").write_text("not a part")
+    rows = tmp_path / "rows.jsonl"
+    run = run_folder(parts, "--rows", rows, "--time-limit", 300)
+    assert run.returncode == 0, run.stderr
+    written = [json.loads(line) for line in rows.read_text().splitlines()]
+    assert {(r["name"], r["size_kind"]) for r in written} == {
+        ("l_shape", "default"), ("l_shape", "d100"), ("open", "default"), ("open", "d100")}
+    good = [r for r in written if r["name"] == "l_shape"]
+    assert all(r["structured_share"] == 1.0 and r["quads"] > 0 for r in good)
+    assert all("open loop" in r["error"] for r in written if r["name"] == "open")
+    assert "default: all in blocks 1/2 (1 errors)" in run.stdout
+
+    again = run_folder(parts, "--names", "l_shape", "--compare", rows)
+    assert again.returncode == 0, again.stderr
+    assert "0 rows differ" in again.stdout  # the same input gives the same mesh
+
+
+def test_an_empty_folder_is_refused(tmp_path):
+    run = run_folder(tmp_path)
+    assert run.returncode == 2 and "no part files" in run.stderr
