@@ -75,7 +75,7 @@ def test_first_planar_face_of_a_solid(tmp_path):
 def test_spline_edges_become_arcs_and_lines_that_follow_them(tmp_path):
     # A polyline would follow the spline as well, but gmsh must put a node on each of its
     # vertices: a gear's sampled flanks made a 2048-node background impossible.
-    from quadcnn_wb.core.input.cad_import import CURVE_TOLERANCE
+    from quadcnn_wb.core.input.arc_splines import CURVE_TOLERANCE
     from quadcnn_wb.core.input.corners import interior_angle
     from quadcnn_wb.core.input.features import is_smooth_join
 

@@ -4,8 +4,7 @@ A sketch's closed wires become a face (holes nested by FreeCAD's bullseye face m
 face is taken as it is.  Coordinates go into the face's own plane (the sketch's placement
 for sketches), so the mesher sees a 2D domain; results go back through the same placement.
 Lines and circular arcs stay exact; B-splines, ellipses and other curves become arc
-splines within CURVE_TOLERANCE of the part size (core.input.arc_splines, the importer's
-rule too).
+splines (core.input.arc_splines, the importer's rule too).
 """
 
 from __future__ import annotations
@@ -15,11 +14,8 @@ import numpy as np
 import Part
 
 from ..core.input.arc_splines import DENSE, arc_spline
-from ..core.input.cad_import import MIN_PIECE
 from ..core.input.curves import Arc, Line, diameter_of
 from ..core.input.domain import DomainError, make_domain
-
-CURVE_TOLERANCE = 1e-4  # chordal deviation for curves that are not lines or arcs (x size)
 
 
 def source_shape_and_placement(source):
@@ -136,7 +132,7 @@ def _edge_pieces(edge, local, local_direction, tol, size):
     if edge.isClosed() and np.hypot(*(points[0] - points[-1])) <= tol:
         points[-1] = points[0]
     tangents = np.array([local_direction(edge.derivative1At(u)) for u in us])
-    return arc_spline(points, tangents, CURVE_TOLERANCE * size, MIN_PIECE * size)
+    return arc_spline(points, tangents, size)
 
 
 def _chain(pieces):

@@ -2,11 +2,7 @@
 
 Read through gmsh's OpenCASCADE importer so no FreeCAD is needed on the command line.
 Lines and circular arcs stay exact; other curve kinds (B-splines, ellipses) become arc
-splines within CURVE_TOLERANCE of their span (or the healing tolerance, if coarser):
-biarcs that keep the curve's tangent at every joint, so no joint is a corner and the
-field follows the curve as it turns.  A polyline kinks at every vertex and each vertex
-is one gmsh must put a node on: a gear's sampled flanks made a background of 2048
-nodes impossible (no fewer than 3978).
+splines (input.arc_splines, the rule FreeCAD's sketches and faces follow too).
 """
 
 from __future__ import annotations
@@ -21,18 +17,8 @@ from .arc_splines import DENSE, arc_spline
 from .curves import Arc, Line, circumcenter, diameter_of
 from .domain import DomainError, make_domain
 
-CURVE_TOLERANCE = 1e-4  # chordal deviation allowed for curves that are not lines or arcs
 EXACT_TOLERANCE = 1e-5  # a curve this close to a line or circle is taken as one (IGES
 #                         writers store circles as B-splines that are off by ~1e-6)
-# A polyline's pieces are at least this long, relative to the face's size: four times the
-# crumbs healing drops (input.healing.HEAL_TOL).  A knurled ring's 840 small B-splines,
-# sampled within 1e-4 of their own span, gave 18728 pieces of 5e-5 of the part, all
-# dropped as crumbs, and the loop was refused as open.
-MIN_PIECE = 4e-4
-# Nor need they follow it closer than the healing tolerance, a quarter of MIN_PIECE (what
-# no mesh shows): fitted to a tenth of a gear flank's micrometre, the flanks took so
-# many arcs that a 2048-node background could not be had.
-FIT = 0.25
 
 
 def read_cad_face(path) -> object:
@@ -58,8 +44,11 @@ def read_cad_face(path) -> object:
                               f"{gmsh.model.getType(2, faces[0])} surface)")
         face = planar[0]
         frame = _plane_frame(face)
-        shortest = MIN_PIECE * _face_size(face, frame)
-        loops = _face_loops(face, frame, shortest)
+        _, curve_lists = gmsh.model.occ.getCurveLoops(face)
+        size = _face_size(curve_lists, frame)
+        loops = [_chain([piece for tag in tags
+                         for piece in _curve_pieces(abs(int(tag)), frame, size)])
+                 for tags in curve_lists]
     loops.sort(key=lambda loop: -_extent(loop))  # holes lie inside: the outer loop is widest
     return make_domain(loops, units="mm")
 
@@ -96,11 +85,10 @@ def _to_plane(frame, xyz) -> np.ndarray:
     return np.stack([d @ ex, d @ ey], axis=-1)
 
 
-def _face_size(face: int, frame) -> float:
+def _face_size(curve_lists, frame) -> float:
     """The face's diameter, from its curves sampled at fixed parameters: the pieces' scale
     must not hang on the part's pose (a bounding box's diagonal does, and a crank web
     turned by 37° got other pieces than in its own pose)."""
-    _, curve_lists = gmsh.model.occ.getCurveLoops(face)
     points = []
     for tag in {abs(int(t)) for tags in curve_lists for t in tags}:
         lo, hi = gmsh.model.getParametrizationBounds(1, tag)
@@ -109,20 +97,9 @@ def _face_size(face: int, frame) -> float:
     return diameter_of(np.vstack(points))
 
 
-def _face_loops(face: int, frame, shortest: float) -> list:
-    _, curve_lists = gmsh.model.occ.getCurveLoops(face)
-    loops = []
-    for curve_tags in curve_lists:
-        pieces = []
-        for tag in curve_tags:
-            pieces.extend(_curve_pieces(abs(int(tag)), frame, shortest))
-        loops.append(_chain(pieces))
-    return loops
-
-
-def _curve_pieces(tag: int, frame, shortest: float) -> list:
+def _curve_pieces(tag: int, frame, part_size: float) -> list:
     """Exact line or arc when the curve is one (whatever OCC calls it), else an arc spline
-    whose pieces are no shorter than ``shortest`` (where the curve is that long)."""
+    at the scale of the part."""
     lo, hi = gmsh.model.getParametrizationBounds(1, tag)
     u0, u1 = float(lo[0]), float(hi[0])
 
@@ -147,7 +124,7 @@ def _curve_pieces(tag: int, frame, shortest: float) -> list:
     ex, ey = frame[1], frame[2]
     d = np.reshape(gmsh.model.getDerivative(1, tag, list(us)), (-1, 3))
     tangents = np.stack([d @ ex, d @ ey], axis=-1)
-    return arc_spline(at(us), tangents, max(CURVE_TOLERANCE * span, FIT * shortest), shortest)
+    return arc_spline(at(us), tangents, part_size)
 
 
 def _endpoints(piece):

@@ -258,3 +258,12 @@ def diameter_of(points) -> float:
         except QhullError:
             pass  # all on one line: every point is a candidate
     return float(np.sqrt(((pts[:, None, :] - pts[None, :, :]) ** 2).sum(-1).max()))
+
+
+def distances_to_segment(points, a, b) -> np.ndarray:
+    """Distances of points from the segment a-b (from a where a and b coincide)."""
+    points = np.asarray(points, dtype=float)
+    d = b - a
+    length2 = float(d @ d)
+    t = np.zeros(len(points)) if length2 == 0.0 else np.clip((points - a) @ d / length2, 0, 1)
+    return np.hypot(*(points - (a + t[:, None] * d)).T)

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .curves import TWO_PI, Arc, Line, cross2
+from .curves import TWO_PI, Arc, Line, cross2, distances_to_segment
 
 HEAL_TOL = 1e-4  # relative to the part's size (bounding-box diagonal)
 
@@ -159,7 +159,7 @@ def _kept_vertices(points, tol: float) -> list:
         i, j = spans.pop()
         if j - i < 2:
             continue
-        d = _off_segment(pts[i + 1:j], pts[i], pts[j])
+        d = distances_to_segment(pts[i + 1:j], pts[i], pts[j])
         far = float(d.max())
         if far <= tol:
             continue
@@ -167,14 +167,6 @@ def _kept_vertices(points, tol: float) -> list:
         kept.update(cuts)
         spans.extend(zip(cuts, cuts[1:]))
     return sorted(kept)
-
-
-def _off_segment(points, a, b) -> np.ndarray:
-    """Distances of points from the segment a-b."""
-    d = b - a
-    length2 = float(d @ d)
-    t = np.zeros(len(points)) if length2 == 0.0 else np.clip((points - a) @ d / length2, 0, 1)
-    return np.hypot(*(points - (a + t[:, None] * d)).T)
 
 
 def _whole_circle(curves, tol: float):
