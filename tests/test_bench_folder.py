@@ -41,3 +41,22 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
 def test_an_empty_folder_is_refused(tmp_path):
     run = run_folder(tmp_path)
     assert run.returncode == 2 and "no part files" in run.stderr
+
+
+def test_gmsh_alg_11_is_measured_beside_ours_on_each_row(tmp_path):
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    shutil.copy(REPO / "resources" / "examples" / "l_shape.json", parts / "l_shape.json")
+    rows = tmp_path / "rows.jsonl"
+    run = run_folder(parts, "--rows", rows, "--gmsh")
+    assert run.returncode == 0, run.stderr
+    written = [json.loads(line) for line in rows.read_text().splitlines()]
+    assert len(written) == 2
+    for row in written:
+        peer = row["gmsh"]
+        # gmsh's quads are its own (alg. 11 splits each triangle in three): more of them,
+        # and the L's re-entrant corner is no irregular vertex of ours
+        assert peer["quads"] > row["quads"] > 0
+        assert 0.0 < peer["min_scaled_jacobian"] <= 1.0 and peer["mesh_s"] > 0.0
+        assert row["irregular_vertices"] <= peer["irregular_vertices"]
+    assert "of the 1 gmsh alg. 11 meshed too: minSJ >= gmsh's" in run.stdout

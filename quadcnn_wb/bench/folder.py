@@ -1,7 +1,7 @@
 """Every part in a folder, meshed at the default size and at diameter / 100.
 
     python -m quadcnn_wb.bench.folder DIR [--rows ROWS.jsonl] [--compare EARLIER.jsonl]
-                                          [--time-limit S] [--names NAME ...]
+                                          [--time-limit S] [--names NAME ...] [--gmsh]
 
 For faces nobody here wrote (a user's own parts, a held-out set of public CAD files): each
 file (.brep .step .stp .iges .igs .json) and size runs in a fresh Python with a time limit,
@@ -10,7 +10,11 @@ appended to ROWS (name, size_kind, structured_share, irregular_vertices,
 min_scaled_jacobian, quads, mesh_s, wall_s, or error); then how many rows are all in
 blocks per size.  With --compare, the rows that differ from an earlier ROWS file (share,
 irregular vertices, errors, or the worst scaled Jacobian by more than 0.01) are listed:
-what a change did to parts the tests do not hold.
+what a change did to parts the tests do not hold.  With --gmsh, each row also holds gmsh's
+quasi-structured algorithm (Mesh.Algorithm 11) on the same face at the same size (its
+irregular vertices, worst scaled Jacobian, quads and seconds, by our own quality code), and
+the summary counts the rows where ours is at least as good and faster: issue 15's bar, on
+faces the tests do not hold.
 """
 
 from __future__ import annotations
@@ -31,27 +35,29 @@ MARK = "@@ROW@@ "
 SJ_CHANGE = 0.01  # a worst scaled Jacobian that moves by more is a difference
 
 
-def worker(path: str, kind: str) -> int:
-    """In the subprocess: mesh one file at one size, print one marked JSON row."""
+def worker(path: str, kind: str, peer: bool = False) -> int:
+    """In the subprocess: mesh one file at one size (with gmsh alg. 11 if ``peer``), print
+    one marked JSON row."""
     row: dict = {}
     try:
         from ..core.input.load import load_domain
-        from ..core.input.pose import diameter
+        from ..core.input.pose import default_size, diameter
         from ..core.pipeline import mesh_domain
 
         domain = load_domain(path)
-        start = time.perf_counter()
-        if kind == "default":
-            result = mesh_domain(domain)
+        size = default_size(domain) if kind == "default" else diameter(domain) / 100.0
+        if peer:
+            row.update(_gmsh_row(domain, size))
         else:
-            result = mesh_domain(domain, size=diameter(domain) / 100.0)
-        row["mesh_s"] = round(time.perf_counter() - start, 3)
-        row.update({
-            "structured_share": float(result.structured_share),
-            "irregular_vertices": int(result.quality["irregular_vertices"]),
-            "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
-            "quads": int(len(result.mesh.quads)),
-        })
+            start = time.perf_counter()
+            result = mesh_domain(domain, size=size)
+            row["mesh_s"] = round(time.perf_counter() - start, 3)
+            row.update({
+                "structured_share": float(result.structured_share),
+                "irregular_vertices": int(result.quality["irregular_vertices"]),
+                "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
+                "quads": int(len(result.mesh.quads)),
+            })
     except Exception as exc:  # a refused file is a row too, with its message
         row["error"] = f"{type(exc).__name__}: {exc}"
         row["traceback_tail"] = traceback.format_exc().strip().splitlines()[-3:]
@@ -59,13 +65,33 @@ def worker(path: str, kind: str) -> int:
     return 0
 
 
-def run_one(path: Path, kind: str, limit: float) -> dict:
-    """One row, from a fresh Python killed (with its children) after ``limit`` s."""
+def _gmsh_row(domain, size: float) -> dict:
+    """gmsh alg. 11's figures on the face, by our own quality code."""
+    from .mesh_vs_gmsh import gmsh_quasi_structured, score
+
+    nodes, quads, boundary, elapsed = gmsh_quasi_structured(domain, size)
+    n_quads, min_sj, _, irregular = score(domain, nodes, quads, boundary)
+    return {"irregular_vertices": int(irregular), "min_scaled_jacobian": float(min_sj),
+            "quads": int(n_quads), "mesh_s": round(float(elapsed), 3)}
+
+
+def run_one(path: Path, kind: str, limit: float, with_gmsh: bool = False) -> dict:
+    """One row, from a fresh Python killed (with its children) after ``limit`` s; with
+    gmsh's row under "gmsh", from a process of its own with the same limit."""
     row = {"name": path.stem, "size_kind": kind}
+    row.update(_run_worker(path, kind, limit, []))
+    if with_gmsh:
+        row["gmsh"] = _run_worker(path, kind, limit, ["gmsh"])
+        row["gmsh"].pop("wall_s")
+    return row
+
+
+def _run_worker(path: Path, kind: str, limit: float, extra: list) -> dict:
+    row = {}
     start = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", __spec__.name, "--worker", str(path), kind],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+    command = [sys.executable, "-m", __spec__.name, "--worker", str(path), kind, *extra]
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
     try:
         out, err = proc.communicate(timeout=limit or None)
     except subprocess.TimeoutExpired:
@@ -91,8 +117,16 @@ def describe(row) -> str:
         return "(missing)"
     if "error" in row:
         return f"error: {row['error'][:70]}"
-    return (f"share {row['structured_share']:.3f} irr {row['irregular_vertices']} "
+    text = (f"share {row['structured_share']:.3f} irr {row['irregular_vertices']} "
             f"sj {row['min_scaled_jacobian']:.3f} quads {row['quads']}")
+    peer = row.get("gmsh")
+    if peer is None:
+        return text
+    if "error" in peer:
+        return text + f" | gmsh error: {peer['error'][:40]}"
+    return text + (f" {row['mesh_s']:.2f}s | gmsh irr {peer['irregular_vertices']} "
+                   f"sj {peer['min_scaled_jacobian']:.3f} quads {peer['quads']} "
+                   f"{peer['mesh_s']:.2f}s")
 
 
 def load_rows(path) -> dict:
@@ -124,7 +158,25 @@ def summary(rows: dict) -> list:
             full = sum(r.get("structured_share") == 1.0 for r in sel)
             errors = sum("error" in r for r in sel)
             lines.append(f"{kind}: all in blocks {full}/{len(sel)} ({errors} errors)")
+            both = [r for r in sel
+                    if "error" not in r and "error" not in r.get("gmsh", {"error": ""})]
+            if both:
+                lines.append(f"{kind}: of the {len(both)} gmsh alg. 11 meshed too: "
+                             f"{_at_least_as_good(both)}")
     return lines
+
+
+def _at_least_as_good(rows) -> str:
+    """Issue 15's bar, counted: worst element, irregular vertices, time against gmsh's."""
+    sj = sum(r["min_scaled_jacobian"] >= r["gmsh"]["min_scaled_jacobian"] for r in rows)
+    irr = sum(r["irregular_vertices"] <= r["gmsh"]["irregular_vertices"] for r in rows)
+    faster = sum(r["mesh_s"] < r["gmsh"]["mesh_s"] for r in rows)
+    every = sum(r["structured_share"] == 1.0
+                and r["min_scaled_jacobian"] >= r["gmsh"]["min_scaled_jacobian"]
+                and r["irregular_vertices"] <= r["gmsh"]["irregular_vertices"]
+                and r["mesh_s"] < r["gmsh"]["mesh_s"] for r in rows)
+    return (f"minSJ >= gmsh's {sj}, irregular <= gmsh's {irr}, faster {faster}; "
+            f"all in blocks and all three {every}")
 
 
 def comparison(earlier: dict, now: dict) -> list:
@@ -139,8 +191,8 @@ def comparison(earlier: dict, now: dict) -> list:
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if len(argv) == 3 and argv[0] == "--worker":
-        return worker(argv[1], argv[2])
+    if len(argv) in (3, 4) and argv[0] == "--worker":
+        return worker(argv[1], argv[2], peer=argv[3:] == ["gmsh"])
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path)
     parser.add_argument("--rows", type=Path, help="append one JSON line per row here")
@@ -148,6 +200,8 @@ def main(argv=None) -> int:
     parser.add_argument("--time-limit", type=float, default=300.0,
                         help="seconds allowed to one file at one size (0: none)")
     parser.add_argument("--names", nargs="+", help="only these files (names without suffix)")
+    parser.add_argument("--gmsh", action="store_true",
+                        help="mesh each face with gmsh's Mesh.Algorithm 11 too and compare")
     args = parser.parse_args(argv)
     files = sorted(p for p in args.folder.iterdir() if p.suffix.lower() in SUFFIXES)
     if args.names:
@@ -158,7 +212,7 @@ def main(argv=None) -> int:
     rows = {}
     for path in files:
         for kind in SIZES:
-            row = run_one(path, kind, args.time_limit)
+            row = run_one(path, kind, args.time_limit, args.gmsh)
             rows[(row["name"], kind)] = row
             if args.rows:
                 with open(args.rows, "a") as fh:
