@@ -423,6 +423,43 @@ def test_blocks_given_up_once_are_not_posed_to_the_program_again(monkeypatch):
     assert 0.0 < result.structured_share < 1.0
 
 
+def test_blocks_whose_counts_cannot_balance_are_found_as_the_exact_program_finds_them(
+        monkeypatch):
+    """The program that may give up any block is exact but slow on big partitions (it ran
+    past its minute on perforated_plate's 1000 blocks, so that layout was lost); the
+    elastic rounds name the blocks left unequal in a fraction of a second and the exact
+    program then chooses among those and their neighbours only.  On grabcad_part19 (as
+    in the test above) it gives up the very blocks the unrestricted program does, and
+    every other block balances."""
+    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core.input.pose import diameter
+    from quadcnn_wb.core.input.small_holes import squared_holes
+    from quadcnn_wb.core.layout import quantize
+
+    posed = []
+    real = pipeline.quantize_freeing
+
+    def recorded(partition, size):
+        posed.append((partition, size))
+        return real(partition, size)
+
+    monkeypatch.setattr(pipeline, "quantize_freeing", recorded)
+    monkeypatch.setattr(quantize, "SHORT_BOUNDARY_ARC", -1.0)
+    domain = load_domain(CORPUS / PARTS["grabcad_part19"]["file"])
+    size = diameter(domain) / 40
+    pipeline._mesh_on_background(squared_holes(domain, size), size, 2048, "numerical", True,
+                                 None)
+    partition, size = posed[0]
+    with pytest.raises(quantize.InfeasibleCounts):
+        quantize.quantize(partition, size)
+    counts, given_up = real(partition, size)
+    _, exact = quantize._solve(partition, size, quantize.MILP_SECONDS, free_blocks=True)
+    assert given_up and given_up == exact
+    sides = quantize.side_counts(partition, counts)
+    for b in set(range(len(partition.blocks))) - set(given_up):
+        assert sides[b][0] == sides[b][2] and sides[b][1] == sides[b][3]
+
+
 @pytest.mark.parametrize("divisor", [None, 100])
 def test_a_separatrix_into_a_notch_corner_keeps_its_corners(divisor):
     """sketch_tslot_profile: where each 45° arm meets its flange (a 225° notch) the

@@ -24,7 +24,7 @@ from .layout.cusps import tip_quads, with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import STAR_CORNERS, build_partition, corners_instead_of_4
-from .layout.partition_types import FreeFace, FreeFaceError, Partition, PartitionError
+from .layout.partition_types import FreeFaceError, Partition, PartitionError, free_blocks
 from .layout.quantize import quantize, quantize_freeing
 from .layout.tracing import trace_streamlines
 from .layout.wedges import without_corner_wedges
@@ -520,18 +520,6 @@ def _block_key(partition: Partition, b: int) -> frozenset:
     """A block named by its corner places, which a rebuild of the same input repeats
     exactly (vertex numbers may change when other edges go)."""
     return frozenset(tuple(partition.vertices[c].tolist()) for c in partition.blocks[b].corners)
-
-
-def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
-    """The partition with these blocks (indices) turned into free faces."""
-    chosen = set(chosen)
-    if not chosen:
-        return partition
-    kept = [b for k, b in enumerate(partition.blocks) if k not in chosen]
-    freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side), reason)
-             for k in sorted(chosen)]
-    return dataclasses.replace(partition, blocks=kept,
-                               free_faces=list(partition.free_faces) + freed)
 
 
 def free_face_problem(partition: Partition) -> str:

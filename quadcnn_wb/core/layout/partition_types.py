@@ -10,7 +10,7 @@ point.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -111,6 +111,18 @@ class Partition:
     def edge_points(self, e: int, forward: bool) -> np.ndarray:
         pts = self.edges[e].points
         return pts if forward else pts[::-1]
+
+
+def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
+    """The partition with these blocks (indices) turned into free faces."""
+    chosen = set(chosen)
+    if not chosen:
+        return partition
+    kept = [b for k, b in enumerate(partition.blocks) if k not in chosen]
+    freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side), reason)
+             for k in sorted(chosen)]
+    return replace(partition, blocks=kept,
+                               free_faces=list(partition.free_faces) + freed)
 
 
 def inside_polygon(polygon, p) -> bool:
