@@ -6,8 +6,10 @@ same input gives the same mesh in another process."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -77,3 +79,23 @@ def test_same_input_same_mesh_in_another_process(tmp_path):
         assert outputs[0][key] == outputs[1][key], key
     assert np.array_equal(np.array(outputs[0]["quads"]), here.mesh.quads)
     assert np.allclose(np.array(outputs[0]["nodes"]), here.mesh.nodes, rtol=0, atol=0)
+
+
+def test_a_part_with_free_faces_gets_the_same_mesh_under_any_hash_seed(tmp_path):
+    """The rounds that give up blocks and dissolve lines keep sets of blocks and lines; no
+    set's iteration order (which PYTHONHASHSEED changes from process to process) may decide
+    the mesh.  blend_scallop_slots at its default size goes through those rounds (a freeing
+    rule tried once made its share 0.566 or 0.569 by the seed)."""
+    part = Path(__file__).parent / "corpus" / "blend_scallop_slots.brep"
+    outputs = []
+    for seed in ("1", "2", "4"):
+        out = tmp_path / f"mesh{seed}.json"
+        env = dict(os.environ, PYTHONHASHSEED=seed)
+        run = subprocess.run([sys.executable, "-m", "quadcnn_wb", "mesh", str(part), "--method",
+                              "numerical", "-o", str(out)],
+                             capture_output=True, text=True, timeout=300, env=env)
+        assert run.returncode == 0, run.stderr
+        outputs.append(json.loads(out.read_text()))
+    assert min(o["block_of_quad"].count(-1) for o in outputs) > 0  # free faces are there
+    for key in ("nodes", "quads", "block_of_quad"):
+        assert outputs[0][key] == outputs[1][key] == outputs[2][key], key
