@@ -66,13 +66,14 @@ def worker(path: str, kind: str, peer: bool = False) -> int:
 
 
 def _gmsh_row(domain, size: float) -> dict:
-    """gmsh alg. 11's figures on the face, by our own quality code."""
-    from .mesh_vs_gmsh import gmsh_quasi_structured, score
+    """gmsh alg. 11's figures on the face (bench.corpus's peer, one run, no limit of its
+    own: the process has one), under this file's row keys."""
+    from .corpus import peer
 
-    nodes, quads, boundary, elapsed = gmsh_quasi_structured(domain, size)
-    n_quads, min_sj, _, irregular = score(domain, nodes, quads, boundary)
-    return {"irregular_vertices": int(irregular), "min_scaled_jacobian": float(min_sj),
-            "quads": int(n_quads), "mesh_s": round(float(elapsed), 3)}
+    figures = peer(domain, size, 1, 0)
+    return {"irregular_vertices": int(figures["irregular"]),
+            "min_scaled_jacobian": float(figures["min_sj"]), "quads": int(figures["quads"]),
+            "mesh_s": round(float(figures["time"]), 3)}
 
 
 def run_one(path: Path, kind: str, limit: float, with_gmsh: bool = False) -> dict:

@@ -121,8 +121,7 @@ def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
     kept = [b for k, b in enumerate(partition.blocks) if k not in chosen]
     freed = [FreeFace(tuple(h for side in partition.blocks[k].sides for h in side), reason)
              for k in sorted(chosen)]
-    return replace(partition, blocks=kept,
-                               free_faces=list(partition.free_faces) + freed)
+    return replace(partition, blocks=kept, free_faces=list(partition.free_faces) + freed)
 
 
 def inside_polygon(polygon, p) -> bool:

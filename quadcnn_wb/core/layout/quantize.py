@@ -38,7 +38,7 @@ from scipy.sparse import coo_matrix
 from .collapse import conflicts, merges, node_layout, stretches
 from .crossings import cumulative_length, point_at
 from .partition_types import Partition, PartitionError
-from .partition_types import free_blocks as given_up
+from .partition_types import free_blocks as given_up  # _solve's free_blocks is a flag
 
 
 def side_counts(partition: Partition, counts) -> list:
@@ -261,7 +261,8 @@ ELASTIC_ROUNDS = 20  # rounds of giving up the blocks the least violation leaves
 
 def _unequal_blocks(partition: Partition, size: float, time_limit: float):
     """Blocks (indices) to give up so that every other block's opposite sides can be
-    equal, found fast; None when these rounds find none (the exact program decides).
+    equal, found fast; [] if none is left unequal, None if a solve or the rounds run out
+    (the exact program decides then).
 
     Each round solves the elastic program: integer counts that violate the blocks'
     equalities as little as possible, a slack s_b >= |side - opposite side| per block,
@@ -273,7 +274,7 @@ def _unequal_blocks(partition: Partition, size: float, time_limit: float):
     """
     n_edges = len(partition.edges)
     chosen: list = []
-    current = partition
+    current, alive = partition, list(range(len(partition.blocks)))  # alive[k]: current k's index
     for _ in range(ELASTIC_ROUNDS):
         base = _base(current, size)
         n_blocks = len(current.blocks)
@@ -298,7 +299,9 @@ def _unequal_blocks(partition: Partition, size: float, time_limit: float):
         unequal = sorted(b for b in range(n_blocks) if result.x[s_col[b]] > 0.5)
         if not unequal:
             return chosen
-        chosen.extend(partition.blocks.index(current.blocks[b]) for b in unequal)
+        gone = set(unequal)
+        chosen.extend(alive[b] for b in unequal)
+        alive = [i for k, i in enumerate(alive) if k not in gone]
         current = given_up(current, unequal, "unequal")
     return None
 
@@ -352,9 +355,8 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks) ->
     integrality = np.concatenate([np.ones(n_edges), np.zeros(n_edges), np.ones(n_edges),
                                   np.ones(n_blocks)])
     # free_blocks: True (any block may be given up), False (none) or the blocks that may
-    z_upper = np.zeros(n_blocks)
-    for k, b in enumerate(block_order):
-        z_upper[k] = 1 if free_blocks is True or (free_blocks and b in free_blocks) else 0
+    may = range(n_blocks) if free_blocks is True else set(free_blocks or ())
+    z_upper = np.array([1.0 if b in may else 0.0 for b in block_order])
     bounds = Bounds(np.concatenate([lower, np.zeros(2 * n_edges), np.zeros(n_blocks)]),
                     np.concatenate([upper, np.full(n_edges, np.inf), upper,
                                     z_upper]))

@@ -129,11 +129,11 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
             slide = slides.get(int(v))
             if fixed[v] and slide is None:
                 continue
-            around = quads[order[starts[v]:starts[v + 1]] // 4]
+            incident = order[starts[v]:starts[v + 1]] // 4
+            around = quads[incident]
             corners = x[around]  # (k, 4, 2)
             current = sj_batch(corners).min()
-            if slide is not None and current >= SLIDE_BELOW \
-                    and not strip[order[starts[v]:starts[v + 1]] // 4].any():
+            if slide is not None and current >= SLIDE_BELOW and not strip[incident].any():
                 continue
             trial, ts = _slide_trials(slide, slides) if slide is not None \
                 else _compass_trials(x, v, corners, steps)
