@@ -1,6 +1,6 @@
-"""Round holes below the element size read as squares (core/input/small_holes.py): no
-singular points round them, their four corners turned to the surrounding boundary, alike
-in every pose."""
+"""Round holes below the element size read as squares (core/input/small_holes.py), and
+small holes of other shapes likewise (input.features): no singular points round them,
+their four corners turned to the surrounding boundary, alike in every pose."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from quadcnn_wb.core.input.domain import domain_from_json
+from quadcnn_wb.core.input.features import SMALL_SHAPED_HOLE, boundary_features
 from quadcnn_wb.core.input.small_holes import SMALL_HOLE, is_quartered, squared_holes
 from quadcnn_wb.core.input.transform import similarity, transform_domain_json
 from quadcnn_wb.core.pipeline import mesh_domain
@@ -81,3 +82,77 @@ def test_a_hole_in_a_boss_thinner_than_an_element_stays_round(outer_radius, squa
                       [{"circle": {"center": [0, 0], "radius": 2.0}}]]}
     domain = squared_holes(domain_from_json(data), 1.5)
     assert is_quartered(domain.loops[1]) is squared
+
+
+# Small holes of other shapes (input.features._small_hole_corners): a plus sign, a letter
+# L and a hexagon, each about an element across, on a plate meshed at SIZE.
+SHAPED = {
+    "plus": [(-1, -3), (1, -3), (1, -1), (3, -1), (3, 1), (1, 1), (1, 3), (-1, 3), (-1, 1),
+             (-3, 1), (-3, -1), (-1, -1)],
+    "ell": [(-3, -3), (3, -3), (3, -1), (-1, -1), (-1, 3), (-3, 3)],
+    "hexagon": [(2 * math.cos(a), 2 * math.sin(a)) for a in np.arange(6) * math.pi / 3],
+}
+
+
+def shaped_plate_json(shapes, scale=1.0):
+    pts = [[0, 0], [100, 0], [100, 50], [0, 50]]
+    outer = [{"line": [pts[i], pts[(i + 1) % 4]]} for i in range(4)]
+    holes = []
+    for k, name in enumerate(shapes):
+        centre = np.array([20.0 + 30.0 * k, 25.0])
+        ring = [centre + scale * np.array(p, float) for p in SHAPED[name]][::-1]  # clockwise
+        holes.append([{"line": [ring[i].tolist(), ring[(i + 1) % len(ring)].tolist()]}
+                      for i in range(len(ring))])
+    return {"loops": [outer] + holes}
+
+
+def test_a_small_hole_of_any_shape_is_read_as_four_square_corners():
+    domain = domain_from_json(shaped_plate_json(["plus", "ell", "hexagon"]))
+    features = boundary_features(domain, SIZE)
+    for loop in (1, 2, 3):
+        mine = [f for f in features if f.loop == loop]
+        assert len(mine) == 4 and all(f.angle == pytest.approx(1.5 * math.pi) for f in mine)
+        # Every joint is flat but the corners: the four stretches cover the rim.
+        assert sum(f.end - f.start for f in mine) == pytest.approx(
+            sum(c.length for c in domain.loops[loop]))
+        # The square's sides run along the plate's (the other holes turn it a little).
+        for f in mine:
+            assert min(abs(f.tangent_in[0]), abs(f.tangent_in[1])) < 1e-3
+    # The plus sign's corners are where its arms reach farthest along the diagonals: an
+    # arm tip's corner each (two tie on each diagonal), not the inner corner between them
+    # (a corner of the plate's material, where a hole's corner folded the quads).
+    plus = [f for f in features if f.loop == 1]
+    corners_xy = [domain.loops[1][f.pivot_segment].point(f.pivot_param) for f in plus]
+    for x, y in corners_xy:
+        assert sorted([abs(x - 20.0), abs(y - 25.0)]) == pytest.approx([1.0, 3.0])
+
+
+def test_a_shaped_hole_of_three_sizes_or_more_is_read_as_it_is():
+    domain = domain_from_json(shaped_plate_json(["plus"], scale=SMALL_SHAPED_HOLE * SIZE / 6))
+    assert not [f for f in boundary_features(domain, SIZE) if f.loop == 1
+                and f.angle is not None and f.angle == pytest.approx(1.5 * math.pi)
+                and len(f.joints) > 0]
+
+
+def test_a_plate_with_small_shaped_holes_is_all_in_blocks():
+    # Read as they are, the plus sign's and the L's corners each sent streamlines, and
+    # the field bent round them into singular points a fraction of an element apart.
+    result = mesh_domain(domain_from_json(shaped_plate_json(["plus", "ell", "hexagon"])),
+                         size=SIZE)
+    assert result.structured_share == 1.0, result.problem
+    assert len(result.reference.field.singularities) == 0
+    assert result.quality["irregular_vertices"] <= 4 * 3
+    assert result.quality["min_scaled_jacobian"] > 0.8
+
+
+@pytest.mark.parametrize("degrees, mirror, scale", [(37.0, False, 1.0), (211.0, True, 1e-3)])
+def test_a_turned_copy_reads_its_shaped_holes_alike(degrees, mirror, scale):
+    data = shaped_plate_json(["plus", "ell", "hexagon"])
+    matrix = similarity(degrees, scale, mirror)
+    shift = np.array([1e4, -3e3]) * scale
+    base = mesh_domain(domain_from_json(data), size=SIZE)
+    moved = mesh_domain(domain_from_json(transform_domain_json(data, matrix, shift)),
+                        size=SIZE * scale)
+    assert len(moved.mesh.quads) == len(base.mesh.quads)
+    assert moved.quality["irregular_vertices"] == base.quality["irregular_vertices"]
+    assert moved.structured_share == base.structured_share == 1.0

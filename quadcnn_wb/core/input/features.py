@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .corners import interior_angle, is_corner, nearest_quarters
-from .small_holes import is_quartered
+from .small_holes import field_direction, is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
@@ -81,6 +81,9 @@ JOINT_GAP = 1e-3  # ... and so is one this close in element sizes (a cut there w
 # polyline falls on must not hang on round-off.
 SMOOTH_TURN = math.radians(12.5)
 CONVEX_MIN = math.radians(22.5)  # a convex feature this sharp or blunter is one corner
+SMALL_SHAPED_HOLE = 3.0  # element sizes: a hole of any shape this small is a square
+HOLE_SAMPLES = 32  # points per curve where a small hole's square corners are sought
+SUPPORT_TIE = 1e-6  # element sizes: points this close to the farthest one tie with it
 
 
 def is_smooth_join(angle: float) -> bool:
@@ -138,6 +141,10 @@ def boundary_features(domain, size: float) -> list:
     for li, loop in enumerate(domain.loops):
         if is_quartered(loop):  # a small round hole, squared (small_holes.py decides)
             out.extend(_square_corners(li, loop))
+            continue
+        small = _small_hole_corners(domain, li, size)
+        if small:
+            out.extend(small)
             continue
         if len(loop) < 2:
             continue  # a lone circle: no corner to read
@@ -234,6 +241,118 @@ def _square_corners(li, loop) -> list:
                     float(0.5 * (offsets[k] + offsets[k + 1])), k, 0.5, 1.5 * math.pi,
                     np.asarray(arc.tangent(0.0), float), np.asarray(arc.tangent(1.0), float))
             for k, arc in enumerate(loop)]
+
+
+def _small_hole_corners(domain, li: int, size: float) -> list:
+    """A hole of any shape smaller than SMALL_SHAPED_HOLE sizes across (a logo's letter,
+    a short slot, a round hole stored as several curves), read as a square, as
+    small_holes reads a round one: four concave corners where the hole reaches farthest
+    along the square's diagonals (turned to the field the other loops impose), each
+    holding a quarter of the rim, every other joint flat.  Read as it is, each of its
+    corners sent streamlines and the field round it had singular points an element
+    apart: a part with five such letters got no block at all.  [] where the rule does
+    not apply (an outer loop, a larger hole, a hole whose farthest points do not come
+    in the diagonals' order round it)."""
+    loop = domain.loops[li]
+    if li == 0 or len(loop) < 2:
+        return []
+    t = np.linspace(0.0, 1.0, HOLE_SAMPLES + 1)[:-1]
+    offsets = loop_offsets(loop)
+    points = np.vstack([np.atleast_2d(c.point(t)) for c in loop])
+    along = np.concatenate([offsets[si] + t * c.length for si, c in enumerate(loop)])
+    # Its diameter, as its widest extent over 64 directions (within 0.03 %; a hole
+    # stored as a fine polyline has too many points for all their pairs).
+    angles = np.arange(64) * (math.pi / 64)
+    reach = points @ np.array([np.cos(angles), np.sin(angles)])
+    if (reach.max(axis=0) - reach.min(axis=0)).max() >= SMALL_SHAPED_HOLE * size:
+        return []
+    total = float(offsets[-1])
+    weights = np.repeat([c.length for c in loop], HOLE_SAMPLES)
+    centre = weights @ points / weights.sum()
+    theta = field_direction(domain, li, centre)
+    pivots = []
+    for k in range(4):
+        a = theta + 0.25 * math.pi + 0.5 * math.pi * k
+        reach = (points - centre) @ np.array([math.cos(a), math.sin(a)])
+        tied = reach >= reach.max() - SUPPORT_TIE * size
+        pivots.append(_farthest_run(domain, li, points, along, tied, total, centre, size))
+    order = np.argsort(pivots)
+    steps = {int(order[(j + 1) % 4] - order[j]) % 4 for j in range(4)}
+    if steps not in ({1}, {3}) or min(np.diff(np.sort(pivots))) <= SUPPORT_TIE * size:
+        return []  # the farthest points do not go round the hole in the diagonals' order
+    pivots = [pivots[j] for j in order]
+    corners = [_at(loop, offsets, s, size) for s in pivots]
+    out = []
+    for j in range(4):
+        before, here, after = pivots[j - 1], pivots[j], pivots[(j + 1) % 4]
+        start = (before + 0.5 * ((here - before) % total)) % total
+        end = start + 0.5 * ((here - before) % total) + 0.5 * ((after - here) % total)
+        seg, param = corners[j]
+        chord_in = _point(loop, offsets, here) - _point(loop, offsets, before)
+        chord_out = _point(loop, offsets, after) - _point(loop, offsets, here)
+        joints = tuple(si for si, at in enumerate(offsets[:-1])
+                       if (at - start) % total <= end - start
+                       and not (param == 0.0 and si == seg))
+        out.append(Feature(li, joints, float(start), float(end), float(here), seg,
+                           float(param), 1.5 * math.pi, _axis(chord_in, theta),
+                           _axis(chord_out, theta)))
+    return out
+
+
+def _farthest_run(domain, li, points, along, tied, total, centre, size) -> float:
+    """Arc length of the corner among the points that reach farthest along a diagonal
+    (``tied``): the middle of a run of them (a side square to the diagonal), never a
+    point between two runs (between a plus sign's two arm tips lies its inner corner, a
+    corner of the part's material that read as a hole's corner folded the quads round
+    it).  Of several runs, the one farthest from the hole's centre, then the nearest to
+    the part's other loops: what a turned or mirrored copy picks alike."""
+    n = len(tied)
+    if tied.all():
+        return 0.0
+    start = int(np.argmin(tied))  # a point of no run: runs are read from there on
+    runs, run = [], []
+    for i in range(start, start + n + 1):
+        if tied[i % n]:
+            run.append(i % n)
+        elif run:
+            runs.append(run)
+            run = []
+    others = np.vstack([np.atleast_2d(c.point(np.linspace(0.0, 1.0, HOLE_SAMPLES)))
+                        for lj, loop in enumerate(domain.loops) if lj != li for c in loop])
+
+    def middle(run):
+        span = (along[run[-1]] - along[run[0]]) % total
+        return (along[run[0]] + 0.5 * span) % total, points[run[len(run) // 2]]
+
+    def key(run):
+        xy = middle(run)[1]
+        nearest = np.hypot(*(others - xy).T).min()
+        return (-round(float(np.hypot(*(xy - centre))) / size, 6),
+                round(float(nearest) / size, 6))
+
+    return float(middle(min(runs, key=key))[0])
+
+
+def _at(loop, offsets, s: float, size: float) -> tuple:
+    """(segment, parameter) at arc length s, on the joint if within JOINT_GAP of one."""
+    seg = int(np.clip(np.searchsorted(offsets, s, side="right") - 1, 0, len(loop) - 1))
+    param = (s - offsets[seg]) / loop[seg].length
+    near = max(JOINT_TOL, JOINT_GAP * size / loop[seg].length)
+    if param >= 1.0 - near:
+        return (seg + 1) % len(loop), 0.0
+    return seg, (0.0 if param <= near else float(param))
+
+
+def _point(loop, offsets, s: float) -> np.ndarray:
+    seg = int(np.clip(np.searchsorted(offsets, s, side="right") - 1, 0, len(loop) - 1))
+    return np.asarray(loop[seg].point((s - offsets[seg]) / loop[seg].length), float)
+
+
+def _axis(chord, theta: float) -> np.ndarray:
+    """The direction of the square's sides (theta + k 90°) nearest to a chord's."""
+    k = round((math.atan2(chord[1], chord[0]) - theta) / (0.5 * math.pi))
+    a = theta + 0.5 * math.pi * k
+    return np.array([math.cos(a), math.sin(a)])
 
 
 def _feature(li, loop, group, total, size) -> Feature | None:

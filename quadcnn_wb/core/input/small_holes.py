@@ -52,7 +52,7 @@ def squared_holes(domain, size: float):
         circle = loop[0]
         if 2.0 * circle.radius >= SMALL_HOLE * size or _in_thin_boss(domain, li, circle, size):
             continue
-        theta = _field_direction(domain, li, circle.center)
+        theta = field_direction(domain, li, circle.center)
         loops[li] = _quarters(circle, theta)
         changed = True
     return dataclasses.replace(domain, loops=tuple(loops)) if changed else domain
@@ -68,7 +68,7 @@ def _in_thin_boss(domain, hole: int, circle: Arc, size: float) -> bool:
                for li, loop in enumerate(domain.loops) if li != hole for c in loop)
 
 
-def _field_direction(domain, hole: int, centre) -> float:
+def field_direction(domain, hole: int, centre) -> float:
     """The cross field's direction (mod 90°) that the other loops impose at ``centre``;
     where they cancel (a hole at the middle of a symmetric part, which any turn of the
     square fits as well), the direction of the part's canonical pose, so that a turned
