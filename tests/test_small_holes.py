@@ -156,3 +156,22 @@ def test_a_turned_copy_reads_its_shaped_holes_alike(degrees, mirror, scale):
     assert len(moved.mesh.quads) == len(base.mesh.quads)
     assert moved.quality["irregular_vertices"] == base.quality["irregular_vertices"]
     assert moved.structured_share == base.structured_share == 1.0
+
+
+def _stadium_hole_json(length, radius):
+    """A plate with a slot of two half circles and two lines (no corner) at (50, 25)."""
+    x0, x1, y0, y1 = 50 - length / 2, 50 + length / 2, 25 - radius, 25 + radius
+    pts = [[0, 0], [100, 0], [100, 50], [0, 50]]
+    outer = [{"line": [pts[i], pts[(i + 1) % 4]]} for i in range(4)]
+    slot = [{"line": [[x1, y1], [x0, y1]]}, {"arc": [[x0, y1], [x0 - radius, 25], [x0, y0]]},
+            {"line": [[x0, y0], [x1, y0]]}, {"arc": [[x1, y0], [x1 + radius, 25], [x1, y1]]}]
+    return {"loops": [outer, slot]}
+
+
+@pytest.mark.parametrize("length, squared", [(1.0, True), (4.0, False)])
+def test_a_hole_with_no_corner_is_squared_only_below_an_element(length, squared):
+    # 0.5 + 2 * 0.75 = 2.5 mm against 4.0 + 1.5 = 5.5 mm long, at 4 mm elements.
+    domain = domain_from_json(_stadium_hole_json(length, 0.75))
+    corners_read = [f for f in boundary_features(domain, SIZE)
+                    if f.loop == 1 and f.angle == pytest.approx(1.5 * math.pi)]
+    assert len(corners_read) == (4 if squared else 0)

@@ -12,6 +12,7 @@ from shapes import polygon
 
 from quadcnn_wb.core.input.domain import domain_from_json
 from quadcnn_wb.core.layout.partition import build_partition
+from quadcnn_wb.core.layout.partition_types import block_area_share, free_blocks
 from quadcnn_wb.core.layout.quantize import quantize
 from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
 from quadcnn_wb.core.mesh.quadmesh import build_quad_mesh
@@ -170,3 +171,22 @@ def test_boundary_edges_are_measured_along_their_curves():
     chords = float(np.hypot(*np.diff(arc.points, axis=0).T).sum())
     assert arc.length == pytest.approx(math.pi / 2, abs=1e-12)
     assert chords < arc.length
+
+
+def test_the_share_of_the_area_in_blocks_is_what_the_free_faces_leave():
+    # The hexagon cut in two: both blocks, one, none (free_blocks), and the share of the
+    # area in blocks that ranks a rebuild against the mesh in hand (pipeline._rounds).
+    domain = _elongated_hexagon()
+    partition = build_partition(domain, [], 1.0, last_resort=True)
+    assert block_area_share(partition, domain.area) == pytest.approx(1.0)
+    assert block_area_share(free_blocks(partition, [0, 1], "test"),
+                            domain.area) == pytest.approx(0.0, abs=1e-12)
+    # The cut runs across the middle: each block holds half the hexagon.
+    assert block_area_share(free_blocks(partition, [0], "test"),
+                            domain.area) == pytest.approx(0.5)
+    # A face with holes: the holes' area is no face's.
+    plate = domain_from_json({"loops": [polygon([[0, 0], [10, 0], [10, 10], [0, 10]]),
+                                        polygon([[4, 6], [6, 6], [6, 4], [4, 4]])]})
+    whole = build_partition(plate, [], 1.0)
+    assert whole.free_faces and not whole.blocks
+    assert block_area_share(whole, plate.area) == pytest.approx(0.0, abs=1e-12)

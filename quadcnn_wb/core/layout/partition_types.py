@@ -124,6 +124,19 @@ def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
     return replace(partition, blocks=kept, free_faces=list(partition.free_faces) + freed)
 
 
+def block_area_share(partition: Partition, domain_area: float) -> float:
+    """The share of the domain's area in blocks (what is not in free faces): the
+    structured share the partition's mesh will have, near enough to rank partitions
+    before meshing them."""
+    free = 0.0
+    for face in partition.free_faces:
+        for ring in face.rings:  # the outline counter-clockwise, holes clockwise
+            pts = np.vstack([partition.edge_points(e, forward) for e, forward in ring])
+            x, y = pts[:, 0], pts[:, 1]
+            free += 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    return 1.0 - free / domain_area
+
+
 def inside_polygon(polygon, p) -> bool:
     """Even-odd rule: p strictly inside the closed polygon (points on it: either way)."""
     x, y = p
