@@ -268,8 +268,8 @@ def _small_hole_corners(domain, li: int, size: float) -> list:
     # stored as a fine polyline has too many points for all their pairs).
     angles = np.arange(64) * (math.pi / 64)
     reach = points @ np.array([np.cos(angles), np.sin(angles)])
-    smooth = all(not is_corner(interior_angle(loop[si - 1], c)) or
-                 is_smooth_join(interior_angle(loop[si - 1], c)) for si, c in enumerate(loop))
+    joints = [interior_angle(loop[si - 1], c) for si, c in enumerate(loop)]
+    smooth = all(not is_corner(a) or is_smooth_join(a) for a in joints)
     limit = SMALL_SMOOTH_HOLE if smooth else SMALL_SHAPED_HOLE
     if (reach.max(axis=0) - reach.min(axis=0)).max() >= limit * size:
         return []
@@ -324,12 +324,14 @@ def _farthest_run(domain, li, points, along, tied, total, centre, size) -> float
         elif run:
             runs.append(run)
             run = []
-    others = np.vstack([np.atleast_2d(c.point(np.linspace(0.0, 1.0, HOLE_SAMPLES)))
-                        for lj, loop in enumerate(domain.loops) if lj != li for c in loop])
-
     def middle(run):
         span = (along[run[-1]] - along[run[0]]) % total
         return (along[run[0]] + 0.5 * span) % total, points[run[len(run) // 2]]
+
+    if len(runs) == 1:
+        return float(middle(runs[0])[0])
+    others = np.vstack([np.atleast_2d(c.point(np.linspace(0.0, 1.0, HOLE_SAMPLES)))
+                        for lj, loop in enumerate(domain.loops) if lj != li for c in loop])
 
     def key(run):
         xy = middle(run)[1]
@@ -340,10 +342,15 @@ def _farthest_run(domain, li, points, along, tied, total, centre, size) -> float
     return float(middle(min(runs, key=key))[0])
 
 
+def _located(loop, offsets, s: float) -> tuple:
+    """(segment, parameter) at arc length s along the loop."""
+    seg = int(np.clip(np.searchsorted(offsets, s, side="right") - 1, 0, len(loop) - 1))
+    return seg, (s - offsets[seg]) / loop[seg].length
+
+
 def _at(loop, offsets, s: float, size: float) -> tuple:
     """(segment, parameter) at arc length s, on the joint if within JOINT_GAP of one."""
-    seg = int(np.clip(np.searchsorted(offsets, s, side="right") - 1, 0, len(loop) - 1))
-    param = (s - offsets[seg]) / loop[seg].length
+    seg, param = _located(loop, offsets, s)
     near = max(JOINT_TOL, JOINT_GAP * size / loop[seg].length)
     if param >= 1.0 - near:
         return (seg + 1) % len(loop), 0.0
@@ -351,8 +358,8 @@ def _at(loop, offsets, s: float, size: float) -> tuple:
 
 
 def _point(loop, offsets, s: float) -> np.ndarray:
-    seg = int(np.clip(np.searchsorted(offsets, s, side="right") - 1, 0, len(loop) - 1))
-    return np.asarray(loop[seg].point((s - offsets[seg]) / loop[seg].length), float)
+    seg, param = _located(loop, offsets, s)
+    return np.asarray(loop[seg].point(param), float)
 
 
 def _axis(chord, theta: float) -> np.ndarray:
@@ -390,13 +397,7 @@ def _feature(li, loop, group, total, size) -> Feature | None:
     # mirrored copy runs it the other way); a concave one's corner sits there, on a joint
     # if the middle is one.
     middle = (start + 0.5 * (end - start)) % total
-    seg = int(np.clip(np.searchsorted(offsets, middle, side="right") - 1, 0, len(loop) - 1))
-    param = (middle - offsets[seg]) / loop[seg].length
-    near = max(JOINT_TOL, JOINT_GAP * size / loop[seg].length)
-    if param >= 1.0 - near:
-        seg, param = (seg + 1) % len(loop), 0.0
-    elif param <= near:
-        param = 0.0
+    seg, param = _at(loop, offsets, middle, size)
     flat = quarters == 2
     joints = tuple(si for si in inside if flat or not (param == 0.0 and si == seg))
     return Feature(li, joints, start, end, middle, seg, float(param), None if flat else angle,

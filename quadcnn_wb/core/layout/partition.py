@@ -32,8 +32,11 @@ from .partition_types import (
     Partition,
     PartitionError,
     fmt,
+    halves_outline,
     inside_polygon,
     pieces_length,
+    polygon_area,
+    signed_area,
 )
 from .subdivide import split_odd_faces
 
@@ -403,14 +406,14 @@ def _with_holes(blocks, free, islands, edges, h) -> tuple:
     faces = [("block", b, tuple(h for side in block.sides for h in side))
              for b, block in enumerate(blocks)]
     faces += [("free", f, face.halves) for f, face in enumerate(free)]
-    outlines = [_outline(edges, halves) for _, _, halves in faces]
+    outlines = [halves_outline(edges, halves) for _, _, halves in faces]
     holes: dict = {}
     for island in islands:
-        probe = _left_of(_outline(edges, island), 1e-3 * h)
+        probe = _left_of(halves_outline(edges, island), 1e-3 * h)
         around = [k for k, o in enumerate(outlines) if inside_polygon(o, probe)]
         if not around:
             raise PartitionError(f"a loop near {fmt(probe)} lies in no face")
-        k = min(around, key=lambda k: abs(_polygon_area(outlines[k])))
+        k = min(around, key=lambda k: abs(polygon_area(outlines[k])))
         holes.setdefault(k, []).append(island)
     out_blocks, out_free = [], []
     for k, (kind, index, halves) in enumerate(faces):
@@ -430,16 +433,6 @@ def _left_of(outline, offset) -> np.ndarray:
     k = int(np.argmax(np.hypot(*d.T)))
     u = d[k] / np.hypot(*d[k])
     return outline[k] + 0.5 * d[k] + offset * np.array([-u[1], u[0]])
-
-
-def _outline(edges, halves) -> np.ndarray:
-    return np.vstack([edges[e].points if forward else edges[e].points[::-1]
-                      for e, forward in halves])
-
-
-def _polygon_area(pts) -> float:
-    return 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1)
-                              - np.roll(pts[:, 0], -1) * pts[:, 1]))
 
 
 def _slits(free, edges) -> set:
@@ -477,9 +470,9 @@ def _slivers(free, faces, edges, h, order) -> set:
     hanging = _HangingCheck(edges)
     out = set()
     for halves in walks:
-        outline = _outline(edges, halves)
+        outline = halves_outline(edges, halves)
         perimeter = float(np.hypot(*np.diff(outline, axis=0).T).sum())
-        if 2.0 * abs(_polygon_area(outline)) >= SLIVER_WIDTH * h * perimeter:
+        if 2.0 * abs(polygon_area(outline)) >= SLIVER_WIDTH * h * perimeter:
             continue  # (a strip of width w and length l: area w l, perimeter 2 l)
         inner = {e for e, _ in halves if not edges[e].is_boundary}
         if len(inner) == len(halves):
@@ -765,7 +758,7 @@ def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4,
                 raise PartitionError("the arrangement of streamlines is not planar")
         if any(edges[half[c][0]].is_boundary and not half[c][1] for c in cycle):
             continue  # outside the domain (the outer face, or inside a hole)
-        if _signed_area(edges, [half[c] for c in cycle]) <= 0:
+        if signed_area(edges, [half[c] for c in cycle]) <= 0:
             islands.append(tuple(half[c] for c in cycle))  # the outside of an island
             continue
         try:
@@ -775,15 +768,11 @@ def _faces_to_blocks(vertices, edges, h, vertex_turns=None, corner_counts=(3, 4,
             places = [vertices[edges[half[c][0]].a if half[c][1] else edges[half[c][0]].b]
                       for c in cycle]
             for lobe in _lobes([half[c] for c in cycle], places, h):
-                if _signed_area(edges, lobe) > 0:
+                if signed_area(edges, lobe) > 0:
                     free.append(FreeFace(lobe, str(exc)))
                 else:
                     islands.append(lobe)
     return blocks, free, islands
-
-
-def _signed_area(edges, halves) -> float:
-    return _polygon_area(_outline(edges, halves))
 
 
 SAME_PLACE = 1e-6  # vertices closer than this (element sizes) are one place of a face
@@ -866,8 +855,7 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
     # turn back, not whichever side round-off put it on.
     at_threshold = np.abs(np.abs(turns) - CORNER_TURN) <= TURN_TIE
     turns = np.where(at_threshold, np.sign(turns) * CORNER_TURN, turns)
-    outline = np.vstack([edges[e].points if f else edges[e].points[::-1]
-                         for e, f in (half[c] for c in cycle)])
+    outline = halves_outline(edges, [half[c] for c in cycle])
     tips = np.array([vertices[head(c)] for c in cycle])
     reflex = turns < -CORNER_TURN
     corner_at = np.nonzero(turns > CORNER_TURN)[0]  # corner at the head of cycle[k]

@@ -3,9 +3,9 @@
 The partition (partition.py) makes them, the subdivision of odd faces (subdivide.py)
 and segment counting (quantize.py) rework them, the mesh builder (mesh/quadmesh.py,
 mesh/free_faces.py) fills them; kept apart from the building so that each of those
-imports the data and not one another.  With them, the two small helpers every stage that
-checks a face uses: the even-odd point-in-polygon test and how an error message names a
-point.
+imports the data and not one another.  With them, the small helpers every stage that
+checks a face uses: a face's outline and signed area, the even-odd point-in-polygon test
+and how an error message names a point.
 """
 
 from __future__ import annotations
@@ -124,16 +124,29 @@ def free_blocks(partition: Partition, chosen, reason: str) -> Partition:
     return replace(partition, blocks=kept, free_faces=list(partition.free_faces) + freed)
 
 
+def halves_outline(edges, halves) -> np.ndarray:
+    """The points round a face given as (edge id, forward) halves."""
+    return np.vstack([edges[e].points if forward else edges[e].points[::-1]
+                      for e, forward in halves])
+
+
+def polygon_area(pts) -> float:
+    """Signed (shoelace) area: positive counter-clockwise."""
+    return 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1)
+                              - np.roll(pts[:, 0], -1) * pts[:, 1]))
+
+
+def signed_area(edges, halves) -> float:
+    return polygon_area(halves_outline(edges, halves))
+
+
 def block_area_share(partition: Partition, domain_area: float) -> float:
     """The share of the domain's area in blocks (what is not in free faces): the
     structured share the partition's mesh will have, near enough to rank partitions
     before meshing them."""
-    free = 0.0
-    for face in partition.free_faces:
-        for ring in face.rings:  # the outline counter-clockwise, holes clockwise
-            pts = np.vstack([partition.edge_points(e, forward) for e, forward in ring])
-            x, y = pts[:, 0], pts[:, 1]
-            free += 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    # A face's outline runs counter-clockwise, its holes clockwise.
+    free = sum(signed_area(partition.edges, ring)
+               for face in partition.free_faces for ring in face.rings)
     return 1.0 - free / domain_area
 
 
