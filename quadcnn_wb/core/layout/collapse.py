@@ -84,6 +84,30 @@ def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
     return np.array(ids, dtype=np.int64)
 
 
+def side_places(layout: NodeLayout, counts, side) -> list:
+    """Raw node ids along a block side, one group per segment end: the vertices that
+    no-segment arcs of the side join are one group (they share a place)."""
+    first_e, first_fwd = side[0]
+    groups = [[int(layout.edge_nodes[first_e][0 if first_fwd else -1])]]
+    for e, forward in side:
+        part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
+        if int(counts[e]) == 0:
+            groups[-1].append(int(part[-1]))
+            continue
+        groups.extend([int(i)] for i in part[1:])
+    return groups
+
+
+def _joining(here, there) -> list:
+    """Links that put two places (groups of raw nodes) in one: each node of one group to
+    the first of the other.  A collapsed strip joins the places, whole: which vertex of a
+    run of no-segment arcs stood for the run depended on the direction the side was
+    walked in, and with it the merges a conflict row names (a mirror image walks every
+    block the other way: four_hole member 21's mirror image got rows of other arcs, and
+    other counts)."""
+    return [(here[0], v) for v in there] + [(u, there[0]) for u in here[1:]]
+
+
 @dataclass
 class Merges:
     parent: np.ndarray  # canonical raw id of every raw node
@@ -108,15 +132,16 @@ def merges(partition, layout: NodeLayout, counts) -> Merges:
             links.append((int(edge.a), int(edge.b), ("edge", e)))
     collapsed = set()
     for b, block in enumerate(partition.blocks):
-        sides = [side_nodes(layout, counts, side) for side in block.sides]
+        sides = [side_places(layout, counts, side) for side in block.sides]
         for pair in (0, 1):
             if len(sides[pair]) == 1:  # no segments across: the other two sides are one
                 collapsed.add(b)
                 other, opposite = sides[pair + 1], sides[(pair + 3) % 4][::-1]
                 if len(other) != len(opposite):
                     continue  # unequal sides: the counts are not a solution; caught later
-                links.extend((int(u), int(v), ("block", b, pair))
-                             for u, v in zip(other, opposite) if u != v)
+                for here, there in zip(other, opposite):
+                    links.extend((u, v, ("block", b, pair)) for u, v in _joining(here, there)
+                                 if u != v)
     for u, v, _ in links:
         ru, rv = find(u), find(v)
         if ru != rv:
