@@ -24,7 +24,7 @@ from ..gmsh_session import gmsh_session
 from ..input.corners import interior_angle, is_corner
 from ..input.curves import Arc
 from ..input.domain import Domain
-from ..input.features import JOINT_TOL, boundary_features, loop_offsets
+from ..input.features import JOINT_TOL, boundary_features, loop_offsets, mean_tangents
 from ..input.pose import KEY_DIGITS, canonical_pose, default_size
 
 NODE_TOLERANCE = 0.05  # the result holds target * (1 ± this) nodes ...
@@ -308,6 +308,13 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
     for feature in features:
         total = float(offsets[feature.loop][-1])
         on_loop = np.nonzero(mesh.boundary_loop == feature.loop)[0]
+        if feature.window:  # a wavy loop: flat all round, its mean tangent
+            flat.update((feature.loop, si) for si in feature.joints)
+            for si in feature.joints:
+                corners.pop(where.get((feature.loop, si)), None)
+            tangents[on_loop] = mean_tangents(domain.loops[feature.loop], along[on_loop],
+                                              feature.window)
+            continue
         segs = mesh.boundary_segment[on_loop]
         s = along[on_loop]
         for si in feature.joints:

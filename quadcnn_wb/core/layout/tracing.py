@@ -56,6 +56,7 @@ class _BoundaryIndex:
             ids = mesh.boundary_nodes[mesh.boundary_loop == li]
             self.next[ids] = np.roll(ids, -1)
         self.corner_nodes = set(mesh.corner_nodes.tolist())
+        self.flat_joints = mesh.flat_joints
         self.inner_corners: dict = {}  # (loop, segment) -> [(param, node)] of feature pivots
         for node in self.corner_nodes:
             if self.param[node] > 0.0:
@@ -94,9 +95,13 @@ class _BoundaryIndex:
             gap, node, tc = min(pivots)
             if gap <= CORNER_SNAP * element and gap < min(along, curve.length - along):
                 return Endpoint("corner", node, li, si, tc), curve.point(tc)
-        if along <= CORNER_SNAP * element:
+        # Not onto a joint read as flat (a step's or a knurl's, input.features): no mesh
+        # node need sit there, and one that did would have the joint's own angle (a
+        # knurled rim's tooth corner of 118° with two quads: an irregular vertex).
+        if along <= CORNER_SNAP * element and (li, si) not in self.flat_joints:
             t = 0.0
-        elif curve.length - along <= CORNER_SNAP * element:
+        elif curve.length - along <= CORNER_SNAP * element \
+                and (li, (si + 1) % len(loop)) not in self.flat_joints:
             li, si, t = li, (si + 1) % len(loop), 0.0
             curve = loop[si]
         if t == 0.0:
