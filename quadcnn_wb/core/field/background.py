@@ -308,18 +308,15 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
     for feature in features:
         total = float(offsets[feature.loop][-1])
         on_loop = np.nonzero(mesh.boundary_loop == feature.loop)[0]
+        for si in feature.joints:
+            flat.add((feature.loop, si))
+            corners.pop(where.get((feature.loop, si)), None)
         if feature.window:  # a wavy loop: flat all round, its mean tangent
-            flat.update((feature.loop, si) for si in feature.joints)
-            for si in feature.joints:
-                corners.pop(where.get((feature.loop, si)), None)
             tangents[on_loop] = mean_tangents(domain.loops[feature.loop], along[on_loop],
                                               feature.window)
             continue
         segs = mesh.boundary_segment[on_loop]
         s = along[on_loop]
-        for si in feature.joints:
-            flat.add((feature.loop, si))
-            corners.pop(where.get((feature.loop, si)), None)
         pivot_s = feature.pivot
         if feature.angle is not None:
             mine = on_loop[segs == feature.pivot_segment]

@@ -72,16 +72,9 @@ SLIDE_SPAN = 0.9
 
 
 def side_nodes(layout: NodeLayout, counts, side) -> np.ndarray:
-    """Raw node ids along a block side: one per segment end (zero-count arcs add none)."""
-    first_e, first_fwd = side[0]
-    start = layout.edge_nodes[first_e][0 if first_fwd else -1]
-    ids = [int(start)]
-    for e, forward in side:
-        if int(counts[e]) == 0:
-            continue
-        part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
-        ids.extend(int(i) for i in part[1:])
-    return np.array(ids, dtype=np.int64)
+    """Raw node ids along a block side: one per segment end (zero-count arcs add none;
+    the first node of each of side_places' groups)."""
+    return np.array([group[0] for group in side_places(layout, counts, side)], dtype=np.int64)
 
 
 def side_places(layout: NodeLayout, counts, side) -> list:
