@@ -37,6 +37,22 @@ def thin_wall():
                                                           [10, 8], [0, 8]])[:-1]
 
 
+def tip_beside_a_fillet(radius=45.0):
+    """A 20-degree tip where a fillet of radius 1 runs into a gently curved side (radius
+    ``radius``), with no tangent: held-out 0043's corner (grabcad 204211), in its own
+    units.  The tip's region is about half an element at sizes 0.6 to 1.2."""
+    tip = np.array([-0.95, -math.sqrt(1 - 0.95 ** 2)])
+    centre = tip + radius * np.array([math.cos(math.radians(3.58)),
+                                      math.sin(math.radians(3.58))])
+    foot = np.array([centre[0] - math.sqrt(radius ** 2 - (-6 - centre[1]) ** 2), -6.0])
+    a0, a1 = (math.atan2(p[1] - centre[1], p[0] - centre[0]) for p in (tip, foot))
+    side_mid = centre + radius * np.array([math.cos(0.5 * (a0 + a1)), math.sin(0.5 * (a0 + a1))])
+    fillet_mid = [math.cos(math.radians(-125)), math.sin(math.radians(-125))]
+    return [{"arc": [tip.tolist(), side_mid.tolist(), foot.tolist()]},
+            {"line": [foot.tolist(), [8, -6]]}, {"line": [[8, -6], [8, -1]]},
+            {"line": [[8, -1], [0, -1]]}, {"arc": [[0, -1], fillet_mid, tip.tolist()]}]
+
+
 def stadium():
     return [{"line": [[0, 0], [2, 0]]}, {"arc": [[2, 0], [3, 1], [2, 2]]},
             {"line": [[2, 2], [0, 2]]}, {"arc": [[0, 2], [-1, 1], [0, 0]]}]

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from shapes import named_domain, rotation, transform_domain
+from shapes import named_domain, rotation, tip_beside_a_fillet, transform_domain
 
 from quadcnn_wb.core.input.corners import interior_angle
 from quadcnn_wb.core.input.domain import domain_from_json
@@ -120,3 +120,17 @@ def test_the_line_from_a_tangent_horns_tip_keeps_to_its_middle():
             assert np.all(np.minimum(to_line, to_arc) > 0.4 * (to_line + to_arc))
             seen += len(near)
     assert seen >= 8
+
+
+@pytest.mark.parametrize("size", [0.6, 1.0])
+def test_only_the_tips_own_corner_of_a_tip_quad_is_excused(size):
+    # The three blocks round a 20-degree tip's singular point, half an element across,
+    # collapsed onto the tip's side: the tip's quad had its 4th corner on that side, flat
+    # (0.006), and went out as the worst element because the whole quad was excused.
+    # Only the tip's own corner is: the quad is a degenerate element, its blocks are
+    # given up and the tip is meshed without the structure it cannot hold.
+    domain = domain_from_json({"loops": [tip_beside_a_fillet()]})
+    result = mesh_domain(domain, size=size)
+    assert result.structured_share == 1.0, result.problem
+    assert result.quality["min_scaled_jacobian"] > 0.5
+    assert result.quality["irregular_vertices"] == 0

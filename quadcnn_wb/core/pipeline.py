@@ -20,7 +20,7 @@ from .input.domain import Domain
 from .input.features import boundary_features
 from .input.pose import default_size
 from .input.small_holes import squared_holes
-from .layout.cusps import tip_quads, with_cusp_kites
+from .layout.cusps import tip_corners, with_cusp_kites
 from .layout.cuts import connecting_cuts
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import STAR_CORNERS, build_partition, corners_instead_of_4
@@ -46,6 +46,7 @@ from .layout_frame import (
     world_result,
 )
 from .mesh.gmsh_quads import gmsh_quad_mesh
+from .mesh.improve import corner_jacobians
 from .mesh.quadmesh import QuadMesh, SquashedBlocks, build_quad_mesh, scaled_jacobians
 from .mesh.quality import mesh_quality, structured_share
 
@@ -493,10 +494,10 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
             freed |= {_block_key(partition, b) for b in exc.blocks}
             continue
         timings["quad_mesh"] += time.perf_counter() - clock
-        sj = scaled_jacobians(mesh.nodes, mesh.quads)
-        # A quad at a cusp's tip is as good as the tip lets it be: it need only not fold.
-        tip = tip_quads(background, mesh.nodes, mesh.quads, size)
-        bad = sj <= np.where(tip, TIP_JACOBIAN, MIN_VALID_JACOBIAN)
+        corner_sj = corner_jacobians(mesh.nodes[mesh.quads])
+        # A corner at a cusp's tip is as good as the tip lets it be: it need only not fold.
+        tip = tip_corners(background, mesh.nodes, mesh.quads, size)
+        bad = (corner_sj <= np.where(tip, TIP_JACOBIAN, MIN_VALID_JACOBIAN)).any(axis=1)
         if not tiles_exactly(mesh.nodes, mesh.quads):
             bad |= crossing_quads(mesh.nodes, mesh.quads)  # blocks folded over others
         folded = {_block_key(partition, int(b)) for b in mesh.block_of_quad[bad] if b >= 0}
@@ -509,12 +510,12 @@ def _rounds(domain, background, lines, cuts, size, smoothing, timings, allow_fre
         freed |= folded
         dissolve = dissolve | merged
     state.update(dissolve=dissolve, freed=freed, unbalanced=unbalanced)
-    if not len(sj):
+    if not len(corner_sj):
         worst = 0.0
-    elif (sj[tip] <= TIP_JACOBIAN).any():
-        worst = float(sj[tip].min())  # folded (or flat) at a cusp's tip
+    elif (corner_sj[tip] <= TIP_JACOBIAN).any():
+        worst = float(corner_sj[tip].min())  # folded (or flat) at a cusp's tip
     else:
-        worst = float(sj[~tip].min(initial=1.0))  # tip quads: as good as their tips allow
+        worst = float(corner_sj[~tip].min(initial=1.0))  # tips: as good as they allow
     if worst <= worst_allowed:
         if worst > 0.0 and tiles_exactly(mesh.nodes, mesh.quads) \
                 and free_edges_on_boundary(mesh.quads, mesh.boundary) \

@@ -44,7 +44,12 @@ class BoundarySlide:
 
 
 def sj_batch(p) -> np.ndarray:
-    """Scaled Jacobian of quads given as corner arrays (..., 4, 2).
+    """Scaled Jacobian of quads given as corner arrays (..., 4, 2)."""
+    return np.min(corner_jacobians(p), axis=-1)
+
+
+def corner_jacobians(p) -> np.ndarray:
+    """Each corner's scaled Jacobian (..., 4) of quads given as corner arrays (..., 4, 2).
 
     Corners picked by index, not np.roll: the same numbers, and the max-min moves call
     this a million times on a big free face (np.roll was a quarter of perforated_plate's
@@ -53,7 +58,7 @@ def sj_batch(p) -> np.ndarray:
     b = p[..., PREVIOUS_CORNER, :] - p
     cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
     norm = np.hypot(a[..., 0], a[..., 1]) * np.hypot(b[..., 0], b[..., 1])
-    return np.min(np.where(norm > 0, cross / np.maximum(norm, 1e-300), -1.0), axis=-1)
+    return np.where(norm > 0, cross / np.maximum(norm, 1e-300), -1.0)
 
 
 def _visiting_order(x, quads, sj, vertices):
