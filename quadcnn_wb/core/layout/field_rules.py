@@ -129,7 +129,7 @@ def arrives_along(alignment):
 # One line per separatrix
 
 
-def claim_separatrices(lengths, starts, ends) -> tuple[list, dict]:
+def claim_separatrices(lengths, starts, ends, joining=frozenset()) -> tuple[list, dict]:
     """(indices of the lines to keep, sorted; {kept line: line holding its end slot}).
 
     A line from source a that arrives at b along b's separatrix k *is* that separatrix
@@ -138,11 +138,12 @@ def claim_separatrices(lengths, starts, ends) -> tuple[list, dict]:
     connection between two singular points is the most trustworthy line.  A line whose
     start slot is still free but whose end slot is taken still stays (its own
     separatrix would be missing otherwise), joined to the line holding that slot.
+    Lines in ``joining`` claim no end slot: kept, they are joined to its holder.
     """
     order = sorted(range(len(lengths)), key=lambda i: lengths[i])
     owner, keep, joins = {}, set(), {}
     for i in order:
-        mine = {starts[i], ends[i]} - {None}
+        mine = {starts[i], None if i in joining else ends[i]} - {None}
         if not any(m in owner for m in mine):
             keep.add(i)
             owner.update({m: i for m in mine})
@@ -155,6 +156,9 @@ def claim_separatrices(lengths, starts, ends) -> tuple[list, dict]:
             owner[start] = i
             if end is not None and end in owner:
                 joins[i] = owner[end]
+    for i in sorted(set(joining) & keep):
+        if owner.get(ends[i], i) != i:
+            joins[i] = owner[ends[i]]
     return sorted(keep), joins
 
 
@@ -172,16 +176,10 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
         return (e.kind, e.index, e.branch) if e.branch >= 0 else None
 
     lines = _along_own_separatrices(_arrival_branches(_ended_on_passed_points(lines, h), h), h)
-    sideways = _sideways_into_corners(lines, h)
-    starts = [slot(line.start) for line in lines]
-    ends = [None if k in sideways else slot(line.end) for k, line in enumerate(lines)]
-    final, joins = claim_separatrices([line.length for line in lines], starts, ends)
-    owner = {slot_: i for i in final for slot_ in (starts[i], ends[i])
-             if slot_ is not None and not (slot_ == ends[i] and i in joins)}
-    for k in sorted(sideways & set(final)):
-        holder = owner.get(slot(lines[k].end))
-        if holder is not None and holder != k:
-            joins[k] = holder
+    final, joins = claim_separatrices([line.length for line in lines],
+                                      [slot(line.start) for line in lines],
+                                      [slot(line.end) for line in lines],
+                                      _sideways_into_corners(lines, h))
     position = {i: k for k, i in enumerate(final)}
     out = []
     for i in final:
