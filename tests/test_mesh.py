@@ -314,6 +314,40 @@ def test_in_a_strip_one_element_thick_a_boundary_node_slides_until_the_quads_are
     assert moved[[0, 2, 3, 4, 5]] == pytest.approx(nodes[[0, 2, 3, 4, 5]])
 
 
+def test_the_worst_corners_round_a_singular_point_are_raised_together():
+    """Three quads round a valence-3 point (a regular hexagon's halves): the best the
+    point can do is 120 degrees at every corner it touches, sin 120 = 0.8660 everywhere.
+    Moved off its place, one-node compass steps bring it back only to within their step;
+    the polish moves the free nodes as one (held-out 0090, a disc, 0.8631 -> 0.8660 where
+    gmsh has 0.8655) and leaves the fixed ones where they are."""
+    from quadcnn_wb.core.mesh.improve import polish_worst, sj_batch
+
+    ring = [[np.cos(a), np.sin(a)] for a in np.radians(np.arange(0, 360, 60))]
+    nodes = np.array([[0.23, -0.11]] + ring)
+    quads = np.array([[0, 1, 2, 3], [0, 3, 4, 5], [0, 5, 6, 1]])
+    fixed = np.ones(len(nodes), dtype=bool)
+    fixed[0] = False
+    assert sj_batch(nodes[quads]).min() < 0.8
+    polished = polish_worst(nodes, quads, fixed)
+    assert sj_batch(polished[quads]).min() == pytest.approx(np.sin(np.radians(120)), abs=1e-6)
+    assert polished[0] == pytest.approx([0.0, 0.0], abs=1e-4)
+    assert polished[1:] == pytest.approx(nodes[1:])
+    fixed[0] = True  # nothing free: nothing moves
+    assert polish_worst(nodes, quads, fixed) == pytest.approx(nodes)
+
+
+@pytest.mark.parametrize(("name", "corners_round_a_point"), [
+    ("disk", 3), ("stadium", 3), ("plate, 1 hole", 5), ("pentagon", 5)])
+def test_a_mesh_bounded_by_its_singular_points_reaches_their_best_corner(name,
+                                                                       corners_round_a_point):
+    """Where nothing but the singular points bounds the quality (no sharp corner), the
+    worst quad is the one the points allow: 360/k degrees at a point of valence k, so
+    sin 120 = 0.8660 for valence 3 and sin 72 = 0.9511 for valence 5 (before the
+    polish: 0.8631, 0.8637, 0.9488 and 0.9511)."""
+    best = abs(np.sin(np.radians(360 / corners_round_a_point)))
+    assert meshed(name).quality["min_scaled_jacobian"] == pytest.approx(best, abs=1e-6)
+
+
 def test_of_two_layouts_a_near_flat_quad_outweighs_a_higher_structured_share():
     """mesh_domain keeps the better of two backgrounds' meshes: more of it in blocks,
     then the better worst element, but one with a quad under FAIR_JACOBIAN loses."""
