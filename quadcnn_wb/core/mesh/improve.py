@@ -251,17 +251,18 @@ def _polished_patch(x, patch, movable, free):
     slot[moving] = np.arange(len(free))
     ends = [slot[quads[:, order]].ravel()[which]
             for order in (np.arange(4), NEXT_CORNER, PREVIOUS_CORNER)]
-    before = round(float(corner_jacobians(base[quads]).ravel()[which].min()), 9)
 
     def placed(z):
         y = base.copy()
         y[moving] = base[moving] + z[:-1].reshape(-1, 2)
         return y
 
-    def constraints(z):
-        return corner_jacobians(placed(z)[quads]).ravel()[which] - z[-1]
+    def corners(z):
+        return corner_jacobians(placed(z)[quads]).ravel()[which]
 
     def gradients(z):
+        # d(cross(a, b) / |a||b|) / da = perp(b) / |a||b| - value a / |a|^2, and alike
+        # for b; the corner's own node moves both a and b the other way.
         p = placed(z)[quads]
         a = (p[:, NEXT_CORNER] - p).reshape(-1, 2)[which]
         b = (p[:, PREVIOUS_CORNER] - p).reshape(-1, 2)[which]
@@ -280,15 +281,17 @@ def _polished_patch(x, patch, movable, free):
         return out
 
     start = np.zeros(2 * len(free) + 1)
+    before = round(float(corners(start).min()), 9)
     start[-1] = before
     gradient = np.zeros_like(start)
     gradient[-1] = -1.0
     found = minimize(lambda z: -z[-1], start, jac=lambda z: gradient, method="SLSQP",
-                     constraints=[{"type": "ineq", "fun": constraints, "jac": gradients}],
+                     constraints=[{"type": "ineq", "fun": lambda z: corners(z) - z[-1],
+                                   "jac": gradients}],
                      options={"maxiter": POLISH_ITERATIONS, "ftol": 1e-10})
     if not np.all(np.isfinite(found.x)):
         return None
-    after = round(float(constraints(found.x).min() + found.x[-1]), 9)
+    after = round(float(corners(found.x).min()), 9)
     if not after > before:
         return None
     return lowest + span * placed(found.x)[moving]
