@@ -22,7 +22,7 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # Faces stored with real gaps between consecutive edges (see SOURCES.md): clear errors.
 OPEN_AS_STORED = {"ventilator_hub"}
 # Partly in blocks: some faces of the partition get unstructured quads (free faces).
-PARTLY_BLOCKS = {"perforated_plate", "blend_sawtooth", "blend_scallop_slots"}
+PARTLY_BLOCKS = {"blend_sawtooth", "blend_scallop_slots"}
 NO_BLOCKS_YET = PARTLY_BLOCKS
 MESHABLE = [name for name in PARTS if name not in OPEN_AS_STORED]
 
@@ -75,7 +75,8 @@ def test_every_face_is_block_structured(name):
     # (A small round hole's square has four such corners.)
     fillets = result.feature_corners
     assert result.quality["irregular_vertices"] <= \
-        len(result.reference.field.singularities) + fillets + 4
+        len(result.reference.field.singularities) + fillets \
+        + max(4, KNOWN_EXTRA_IRREGULAR.get(name, 0))
 
 
 # Irregular vertices besides the singular points and feature corners, where known:
@@ -88,11 +89,14 @@ def test_every_face_is_block_structured(name):
 # (its 2048-node layout, all blocks since layout.wedges: worst scaled Jacobian 0.84
 # against the finer layout's 0.71, which had none); blend_horn_square's kite corner at
 # its horn's 0° tip; blend_slotted_plate's four, not yet told apart (its slots' round
-# ends read as corners with four quads; 59 irregular vertices against gmsh's 179).
+# ends read as corners with four quads; 59 irregular vertices against gmsh's 179);
+# perforated_plate's 29, where the lines of its 89 squared holes' corners end on each
+# other (389 against gmsh's 786; all blocks at the default size since those lines leave
+# straight along the squares' sides: 0.97 before).
 KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyhole_plate": 2,
                          "nist_ctc04_plate": 4,
                          "crankshaft_web_keyway": 2, "blend_horn_square": 1,
-                         "blend_slotted_plate": 4}
+                         "blend_slotted_plate": 4, "perforated_plate": 29}
 
 
 @pytest.mark.parametrize("name", [n for n in MESHABLE if n not in PARTLY_BLOCKS])
@@ -109,8 +113,7 @@ def test_the_irregular_vertices_are_the_fields_own(name):
 
 
 # At the second size of the corpus benchmark (bench.corpus: diameter / 100).  Not
-# perforated_plate: 100 s there (the benchmark command measures it; its default size is
-# an expected failure above).
+# perforated_plate: 100 s there (the benchmark command measures it).
 FINE_TOO_SLOW = {"perforated_plate"}
 # All in blocks there, with irregular vertices beyond the singular points and feature
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
@@ -138,14 +141,16 @@ def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
 
 def test_a_face_without_blocks_says_so(monkeypatch):
     # No corpus face falls back as a whole any more; with no rebuild allowed, the free
-    # faces of nist_ctc04_plate that cannot be filled on the 2048-node background (and no
-    # finer one allowed) leave no block partition, and the quads that stand in (gmsh's,
+    # faces of blend_scallop_slots that cannot be filled on the 2048-node background (and
+    # no finer one allowed) leave no block partition, and the quads that stand in (gmsh's,
     # or the whole face as one free face where those fold) must say so everywhere.
+    # (nist_ctc04_plate did so until its small holes' corner lines left straight along
+    # the squares' sides: then only one face of 190 was no block.)
     from quadcnn_wb.core import pipeline
 
     monkeypatch.setattr(pipeline, "FREEING_ROUNDS", 0)
     monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
-    result = mesh_domain(load_domain(CORPUS / PARTS["nist_ctc04_plate"]["file"]))
+    result = mesh_domain(load_domain(CORPUS / PARTS["blend_scallop_slots"]["file"]))
     assert not result.structured and "no block structure" in result.problem
     assert "stand in" in result.problem and result.quality["min_scaled_jacobian"] > 0
     data = result.to_json()

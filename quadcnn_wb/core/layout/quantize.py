@@ -160,7 +160,14 @@ class _Problem:
 
 
 class InfeasibleCounts(PartitionError):
-    """No counts make every block's opposite sides equal (HiGHS: the model is infeasible)."""
+    """No counts make every block's opposite sides equal (HiGHS: the model is infeasible).
+    ``forbidden``: the rows against pinches the solves had found by then (variable
+    positions, at least one segment among each row's): they hold for any counts, blocks
+    given up or not, so a program that may give blocks up starts from them."""
+
+    def __init__(self, message: str, forbidden=()):
+        super().__init__(message)
+        self.forbidden = [list(row) for row in forbidden]
 
 
 MILP_SECONDS = 60.0  # per solve; past it the counts are refused, not taken unproven
@@ -180,19 +187,37 @@ def quantize_freeing(partition: Partition, size: float,
     case, and the faster program), else as few given up as the traces force."""
     try:
         return _solve(partition, size, time_limit, free_blocks=False)
-    except InfeasibleCounts:
-        pass
-    unequal = _unequal_blocks(partition, size, time_limit)
-    if unequal:
+    except InfeasibleCounts as exc:
+        forbidden = exc.forbidden
+    # The blocks the elastic program leaves unequal, and those whose counts the rows
+    # against pinches hold (balanced, the counts may still pinch: nist_ctc04_plate's
+    # 2048-node layout once squared holes' lines left straight, all blocks balanced, a
+    # pinch in every balanced solution).
+    suspects = set(_unequal_blocks(partition, size, time_limit) or ()) \
+        | _blocks_of_variables(partition, size, forbidden)
+    if suspects:
         # The fewest blocks to give up, chosen among those and their neighbours only:
         # exact where it counts, and fast (a program that may give up any of 1000 blocks
-        # ran past a minute; perforated_plate's finer layout).
+        # ran past a minute, perforated_plate's finer layout; any of nist_ctc04_plate's
+        # 189, 3 s a solve and 7 solves).
         try:
             return _solve(partition, size, time_limit,
-                          free_blocks=_with_neighbours(partition, unequal))
+                          free_blocks=_with_neighbours(partition, suspects),
+                          forbidden=forbidden)
         except PartitionError:
             pass
-    return _solve(partition, size, time_limit, free_blocks=True)
+    return _solve(partition, size, time_limit, free_blocks=True, forbidden=forbidden)
+
+
+def _blocks_of_variables(partition: Partition, size: float, rows) -> set:
+    """The blocks with a side on an edge whose count variable is in one of ``rows``."""
+    if not rows:
+        return set()
+    position = _base(partition, size).position
+    edges = {e for e in range(len(partition.edges))
+             if int(position[e]) in {v for row in rows for v in row}}
+    return {b for b, block in enumerate(partition.blocks)
+            if any(e in edges for side in block.sides for e, _ in side)}
 
 
 def _with_neighbours(partition: Partition, blocks) -> set:
@@ -306,7 +331,8 @@ def _unequal_blocks(partition: Partition, size: float, time_limit: float):
     return None
 
 
-def _solve(partition: Partition, size: float, time_limit: float, free_blocks) -> tuple:
+def _solve(partition: Partition, size: float, time_limit: float, free_blocks,
+           forbidden=()) -> tuple:
     """(counts per edge, indices of blocks given up to free faces).
 
     Edges of free faces get an even count of at least 2 (n_e = 2 m_e): their quads come
@@ -316,6 +342,8 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks) ->
     given up, each edge takes 2 or more even segments and nothing else constrains it.  The
     solver gives up as few blocks as the traces force (numerical traces satisfy the
     equalities only approximately; chains of T-junctions can contradict each other).
+    ``forbidden``: rows against pinches found by an earlier solve of this partition
+    (InfeasibleCounts.forbidden), posed from the start instead of found again.
     """
     n_edges, n_blocks = len(partition.edges), len(partition.blocks)
     if n_edges == 0:
@@ -360,9 +388,11 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks) ->
     bounds = Bounds(np.concatenate([lower, np.zeros(2 * n_edges), np.zeros(n_blocks)]),
                     np.concatenate([upper, np.full(n_edges, np.inf), upper,
                                     z_upper]))
-    forbidden = []  # rows: at least one segment among these variables
+    forbidden = [list(row) for row in forbidden]  # rows: >= 1 segment among these variables
     # ... and rows against stretches, kept only while they cost no block (a chain of
-    # short arcs may have no other way to close than to collapse).
+    # short arcs may have no other way to close than to collapse); not posed at all
+    # where blocks are given up already (they would be dropped again after a solve,
+    # and the next solve is the one before them: two of nist_ctc04_plate's 3 s solves).
     unstretched, stretching = [], True
     for _ in range(MAX_ROUNDS):
         extra = [(dict.fromkeys(f, 1), 1, np.inf) for f in forbidden + unstretched]
@@ -375,7 +405,7 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks) ->
             continue
         if result.x is None and result.status == 2:  # proven infeasible
             raise InfeasibleCounts(f"no segment counts make opposite block sides equal "
-                                   f"({result.message})")
+                                   f"({result.message})", forbidden)
         if result.status != 0:  # a time-limited answer would depend on the machine's speed
             raise PartitionError(f"the segment-count program found no proven optimum "
                                  f"within {time_limit:g} s ({result.message})")
@@ -388,7 +418,7 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks) ->
         found_merges = merges(reduced, layout, counts)
         found = conflicts(layout, found_merges, key=variables_of)
         stretched = stretches(layout, found_merges, key=variables_of) if not found else []
-        if not found and not stretched:
+        if not found and (not stretched or freed):
             return counts, freed
         for reasons in found:
             forbidden.append(sorted({v for reason in reasons for v in variables_of(reason)}))

