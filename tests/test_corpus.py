@@ -465,6 +465,79 @@ def test_blocks_whose_counts_cannot_balance_are_found_as_the_exact_program_finds
         assert sides[b][0] == sides[b][2] and sides[b][1] == sides[b][3]
 
 
+def _first_partition(name, nodes=2048):
+    """The first partition the pipeline poses to the segment-count program for a corpus
+    part at its default size, on ``nodes`` background nodes."""
+    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core.input.pose import default_size
+    from quadcnn_wb.core.input.small_holes import squared_holes
+
+    posed = []
+
+    class Posed(Exception):
+        pass
+
+    def record(partition, size):
+        posed.append((partition, size))
+        raise Posed
+
+    domain = load_domain(CORPUS / PARTS[name]["file"])
+    size = default_size(domain)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(pipeline, "quantize_freeing", record)
+        with pytest.raises(Posed):
+            pipeline._mesh_on_background(squared_holes(domain, size), size, nodes,
+                                         "numerical", True, None)
+    return posed[0]
+
+
+def test_counts_that_pinch_in_every_balanced_solution_give_up_a_block_near_the_pinch():
+    """nist_ctc04_plate's 2048-node layout: every block's sides balance (the elastic
+    program leaves none unequal), but every balanced solution merges two anchors, so the
+    program with every block kept is infeasible once the rows against pinches are in.
+    Those rows come with the refusal, and the program that may give blocks up starts from
+    them and chooses among the blocks they name and their neighbours (6 s, where the one
+    that may give up any of the 189 took 19 s): it gives up as few as the unrestricted
+    program, and every other block balances."""
+    from quadcnn_wb.core.layout import quantize
+
+    partition, size = _first_partition("nist_ctc04_plate")
+    with pytest.raises(quantize.InfeasibleCounts) as refused:
+        quantize.quantize(partition, size)
+    assert refused.value.forbidden
+    assert quantize._unequal_blocks(partition, size, quantize.MILP_SECONDS) == []
+    counts, given_up = quantize.quantize_freeing(partition, size)
+    assert 0 < len(given_up) < 3
+    assert given_up and set(given_up) <= quantize._with_neighbours(
+        partition, quantize._blocks_of_variables(partition, size, refused.value.forbidden))
+    sides = quantize.side_counts(partition, counts)
+    for b in set(range(len(partition.blocks))) - set(given_up):
+        assert sides[b][0] == sides[b][2] and sides[b][1] == sides[b][3]
+
+
+def test_a_first_layout_that_must_give_a_block_up_stops_before_choosing_which(monkeypatch):
+    """The race to a finer background (pipeline._best_layout) wants to know only whether
+    the first layout leaves free faces; choosing which blocks to give up is the slow
+    program, so it is not posed (nist_ctc04_plate at its default size: 2 s in all, 22.8 s
+    when it was)."""
+    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core.input.pose import default_size
+    from quadcnn_wb.core.input.small_holes import squared_holes
+
+    def refuse(partition, size):
+        raise AssertionError("the program that gives blocks up was posed")
+
+    monkeypatch.setattr(pipeline, "quantize_freeing", refuse)
+    domain = load_domain(CORPUS / PARTS["nist_ctc04_plate"]["file"])
+    size = default_size(domain)
+    with pytest.raises(pipeline.LeavesFreeFaces):
+        pipeline._mesh_on_background(squared_holes(domain, size), size, 2048, "numerical",
+                                     True, None, stop_at_free=True)
+    monkeypatch.undo()  # the finer layout, all in blocks, poses it as it should
+    result = mesh_domain(domain)
+    assert result.structured_share == 1.0 and result.quality["min_scaled_jacobian"] > 0.8
+
+
 @pytest.mark.parametrize("divisor", [None, 100])
 def test_a_separatrix_into_a_notch_corner_keeps_its_corners(divisor):
     """sketch_tslot_profile: where each 45° arm meets its flange (a 225° notch) the
