@@ -1,0 +1,43 @@
+"""Splitting a face of the partition round a centre (layout.subdivide): the spokes must
+stay inside the face, also where a side bulges in without a reflex corner."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from quadcnn_wb.core.layout.partition_types import Edge
+from quadcnn_wb.core.layout.subdivide import _inside, split_odd_faces
+
+
+def _bulging_pentagon():
+    """Five corners, counter-clockwise; the side from the last corner back to the first
+    bulges deep into the face (a boundary curve seen from inside), so the mean of the
+    corners and side middles lies beyond it, outside the face."""
+    corners = [np.array(p, dtype=float) for p in ((0, 0), (4, 0), (4, 3), (2, 4), (0, 3))]
+    edges = []
+    for a in range(5):
+        b = (a + 1) % 5
+        if b == 0:  # corner 4 -> corner 0, bulging in to x = 2.8 half-way
+            t = np.linspace(0.0, 1.0, 41)
+            points = np.column_stack([2.8 * np.sin(np.pi * t), 3.0 * (1.0 - t)])
+        else:
+            points = np.linspace(corners[a], corners[b], 9)
+        edges.append(Edge(points=points, a=a, b=b))
+    sides = [[(e, True)] for e in range(5)]
+    return corners, edges, sides
+
+
+def test_a_face_whose_side_bulges_in_gets_its_centre_where_every_spoke_stays_inside():
+    vertices, edges, sides = _bulging_pentagon()
+    outline = np.vstack([edge.points[:-1] for edge in edges])
+    naive = np.mean(vertices + [edge.points[len(edge.points) // 2] for edge in edges], axis=0)
+    assert not _inside(outline, naive, vertices[2])  # what the mean centre would do
+    edges_out = list(edges)
+    vertices_out, blocks, free = split_odd_faces(vertices, edges_out, [(list(range(5)),
+                                                  sides, ())], [], None)
+    assert len(blocks) == 5 and not free
+    centre_id = len(vertices_out) - 1
+    spokes = [edge for edge in edges_out if edge.a == centre_id]
+    assert len(spokes) == 5
+    for spoke in spokes:
+        assert _inside(outline, spoke.points[0], spoke.points[-1])
