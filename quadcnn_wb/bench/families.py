@@ -28,25 +28,36 @@ POSES = (  # (degrees, mirrored, scale, shift in part sizes)
     (131.0, False, 1e-3, 3.0), (73.0, True, 1e3, -7.0))
 
 
-def _signature(result) -> tuple:
+def pose_signature(result) -> tuple:
+    """What a turned, moved, mirrored or rescaled copy must share with the part."""
     q = result.quality
     return result.structured_share, q["blocks"], q["quads"], q["irregular_vertices"]
+
+
+def poses_differing(data: dict, base, size: float | None = None) -> list:
+    """The POSES (indices) whose copy of the domain JSON ``data`` gets other blocks, quads,
+    irregular vertices or structured share than ``base``, meshed at ``size`` scaled with
+    the copy (the copy's default size where None)."""
+    from ..core.input.domain import domain_from_json
+    from ..core.input.transform import similarity, transform_domain_json
+    from ..core.pipeline import mesh_domain
+
+    extent = base.domain.size
+    differing = []
+    for k, (degrees, mirrored, scale, shift) in enumerate(POSES):
+        moved = transform_domain_json(data, similarity(degrees, scale, mirrored),
+                                      np.full(2, shift * extent * scale))
+        result = mesh_domain(domain_from_json(moved),
+                             size=None if size is None else size * scale)
+        if pose_signature(result) != pose_signature(base):
+            differing.append(k)
+    return differing
 
 
 def same_in_every_pose(data: dict, base) -> bool:
     """Whether every POSES copy of the domain JSON ``data`` gets ``base``'s blocks, quads
     and irregular vertices."""
-    from ..core.input.domain import domain_from_json
-    from ..core.input.transform import similarity, transform_domain_json
-    from ..core.pipeline import mesh_domain
-
-    size = base.domain.size
-    for degrees, mirrored, scale, shift in POSES:
-        moved = transform_domain_json(data, similarity(degrees, scale, mirrored),
-                                      np.full(2, shift * size * scale))
-        if _signature(mesh_domain(domain_from_json(moved))) != _signature(base):
-            return False
-    return True
+    return not poses_differing(data, base)
 
 
 def run_member(name: str, seed: int, index: int, poses: bool = False) -> dict:

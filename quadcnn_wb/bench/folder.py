@@ -2,6 +2,7 @@
 
     python -m quadcnn_wb.bench.folder DIR [--rows ROWS.jsonl] [--compare EARLIER.jsonl]
                                           [--time-limit S] [--names NAME ...] [--gmsh]
+                                          [--poses]
 
 For faces nobody here wrote (a user's own parts, a held-out set of public CAD files): each
 file (.brep .step .stp .iges .igs .json) and size runs in a fresh Python with a time limit,
@@ -15,7 +16,11 @@ what a change did to parts the tests do not hold.  With --gmsh, each row also ho
 quasi-structured algorithm (Mesh.Algorithm 11) on the same face at the same size (its
 irregular vertices, worst scaled Jacobian, quads and seconds, by our own quality code), and
 the summary counts the rows where ours is at least as good and faster: issue 15's bar, on
-faces the tests do not hold.
+faces the tests do not hold.  With --poses, each face is also meshed (from its domain
+JSON) in bench.families' five POSES (turned by odd angles, moved by 1e4 of its size,
+mirrored, scaled by 1e-3 and 1e3) at the row's size scaled with it, and the row says
+whether every copy got the same share, blocks, quads and irregular vertices
+(``same_in_poses``, ``poses_differing``); the time limit then covers all six meshes.
 """
 
 from __future__ import annotations
@@ -36,9 +41,9 @@ MARK = "@@ROW@@ "
 SJ_CHANGE = 0.01  # a worst scaled Jacobian that moves by more is a difference
 
 
-def worker(path: str, kind: str, peer: bool = False) -> int:
-    """In the subprocess: mesh one file at one size (with gmsh alg. 11 if ``peer``), print
-    one marked JSON row."""
+def worker(path: str, kind: str, peer: bool = False, poses: bool = False) -> int:
+    """In the subprocess: mesh one file at one size (with gmsh alg. 11 if ``peer``; in
+    every pose too if ``poses``), print one marked JSON row."""
     row: dict = {}
     try:
         from ..core.input.load import load_domain
@@ -60,6 +65,8 @@ def worker(path: str, kind: str, peer: bool = False) -> int:
                 "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
                 "quads": int(len(result.mesh.quads)),
             })
+            if poses:
+                row.update(_pose_row(domain, size))
     except Exception as exc:  # a refused file is a row too, with its message
         row["error"] = f"{type(exc).__name__}: {exc}"
         row["traceback_tail"] = traceback.format_exc().strip().splitlines()[-3:]
@@ -86,6 +93,19 @@ def warm_up() -> None:
     mesh_domain(domain_from_json(WARM_UP_PART))
 
 
+def _pose_row(domain, size: float) -> dict:
+    """Whether the face's copies in every pose get the mesh its own JSON gets (the copies
+    are made from that JSON, so the round trip is not what is compared)."""
+    from ..core.input.domain import domain_from_json
+    from ..core.pipeline import mesh_domain
+    from .families import poses_differing
+
+    data = domain.to_json()
+    base = mesh_domain(domain_from_json(data), size=size)
+    differing = poses_differing(data, base, size)
+    return {"same_in_poses": not differing, "poses_differing": differing}
+
+
 def _gmsh_row(domain, size: float) -> dict:
     """gmsh alg. 11's figures on the face (bench.corpus's peer, one run, no limit of its
     own: the process has one), under this file's row keys."""
@@ -97,11 +117,12 @@ def _gmsh_row(domain, size: float) -> dict:
             "mesh_s": round(float(figures["time"]), 3)}
 
 
-def run_one(path: Path, kind: str, limit: float, with_gmsh: bool = False) -> dict:
+def run_one(path: Path, kind: str, limit: float, with_gmsh: bool = False,
+            poses: bool = False) -> dict:
     """One row, from a fresh Python killed (with its children) after ``limit`` s; with
     gmsh's row under "gmsh", from a process of its own with the same limit."""
     row = {"name": path.stem, "size_kind": kind}
-    row.update(_run_worker(path, kind, limit, []))
+    row.update(_run_worker(path, kind, limit, ["poses"] if poses else []))
     if with_gmsh:
         row["gmsh"] = _run_worker(path, kind, limit, ["gmsh"])
         row["gmsh"].pop("wall_s")
@@ -141,6 +162,9 @@ def describe(row) -> str:
         return f"error: {row['error'][:70]}"
     text = (f"share {row['structured_share']:.3f} irr {row['irregular_vertices']} "
             f"sj {row['min_scaled_jacobian']:.3f} quads {row['quads']}")
+    if "same_in_poses" in row:
+        text += " poses: same" if row["same_in_poses"] else \
+            f" poses: differ in {row['poses_differing']}"
     peer = row.get("gmsh")
     if peer is None:
         return text
@@ -185,6 +209,10 @@ def summary(rows: dict) -> list:
             if both:
                 lines.append(f"{kind}: of the {len(both)} gmsh alg. 11 meshed too: "
                              f"{_at_least_as_good(both)}")
+            posed = [r for r in sel if "same_in_poses" in r]
+            if posed:
+                same = sum(r["same_in_poses"] for r in posed)
+                lines.append(f"{kind}: the same in every pose {same}/{len(posed)}")
     return lines
 
 
@@ -214,7 +242,8 @@ def comparison(earlier: dict, now: dict) -> list:
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) in (3, 4) and argv[0] == "--worker":
-        return worker(argv[1], argv[2], peer=argv[3:] == ["gmsh"])
+        return worker(argv[1], argv[2], peer=argv[3:] == ["gmsh"],
+                      poses=argv[3:] == ["poses"])
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path)
     parser.add_argument("--rows", type=Path, help="append one JSON line per row here")
@@ -224,6 +253,9 @@ def main(argv=None) -> int:
     parser.add_argument("--names", nargs="+", help="only these files (names without suffix)")
     parser.add_argument("--gmsh", action="store_true",
                         help="mesh each face with gmsh's Mesh.Algorithm 11 too and compare")
+    parser.add_argument("--poses", action="store_true",
+                        help="also mesh each face turned, moved, mirrored and rescaled, "
+                             "and say whether every copy gets the same mesh")
     args = parser.parse_args(argv)
     files = sorted(p for p in args.folder.iterdir() if p.suffix.lower() in SUFFIXES)
     if args.names:
@@ -234,7 +266,7 @@ def main(argv=None) -> int:
     rows = {}
     for path in files:
         for kind in SIZES:
-            row = run_one(path, kind, args.time_limit, args.gmsh)
+            row = run_one(path, kind, args.time_limit, args.gmsh, args.poses)
             rows[(row["name"], kind)] = row
             if args.rows:
                 with open(args.rows, "a") as fh:
