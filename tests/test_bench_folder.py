@@ -38,19 +38,24 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
     assert "0 rows differ" in again.stdout  # the same input gives the same mesh
 
 
+def run_on_one_part(tmp_path, example, *flags) -> tuple:
+    """The benchmark on a folder holding one bundled example: (run, rows written)."""
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    shutil.copy(REPO / "resources" / "examples" / example, parts / example)
+    rows = tmp_path / "rows.jsonl"
+    run = run_folder(parts, "--rows", rows, *flags)
+    assert run.returncode == 0, run.stderr
+    return run, [json.loads(line) for line in rows.read_text().splitlines()]
+
+
 def test_an_empty_folder_is_refused(tmp_path):
     run = run_folder(tmp_path)
     assert run.returncode == 2 and "no part files" in run.stderr
 
 
 def test_gmsh_alg_11_is_measured_beside_ours_on_each_row(tmp_path):
-    parts = tmp_path / "parts"
-    parts.mkdir()
-    shutil.copy(REPO / "resources" / "examples" / "l_shape.json", parts / "l_shape.json")
-    rows = tmp_path / "rows.jsonl"
-    run = run_folder(parts, "--rows", rows, "--gmsh")
-    assert run.returncode == 0, run.stderr
-    written = [json.loads(line) for line in rows.read_text().splitlines()]
+    run, written = run_on_one_part(tmp_path, "l_shape.json", "--gmsh")
     assert len(written) == 2
     for row in written:
         peer = row["gmsh"]
@@ -65,13 +70,7 @@ def test_gmsh_alg_11_is_measured_beside_ours_on_each_row(tmp_path):
 def test_each_face_is_checked_in_every_pose(tmp_path):
     # The corpus and family tests turn shapes the project drew or cut; a user's own folder
     # (the held-out faces) is checked the same way by the benchmark.
-    parts = tmp_path / "parts"
-    parts.mkdir()
-    shutil.copy(REPO / "resources" / "examples" / "plate_hole.json", parts / "plate_hole.json")
-    rows = tmp_path / "rows.jsonl"
-    run = run_folder(parts, "--rows", rows, "--poses")
-    assert run.returncode == 0, run.stderr
-    written = [json.loads(line) for line in rows.read_text().splitlines()]
+    run, written = run_on_one_part(tmp_path, "plate_hole.json", "--poses")
     assert len(written) == 2
     for row in written:
         assert row["same_in_poses"] is True and row["poses_differing"] == []
