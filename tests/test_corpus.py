@@ -509,7 +509,7 @@ def test_counts_that_pinch_in_every_balanced_solution_give_up_a_block_near_the_p
     counts, given_up = quantize.quantize_freeing(partition, size)
     assert 0 < len(given_up) < 3
     assert given_up and set(given_up) <= quantize._with_neighbours(
-        partition, quantize._blocks_of_variables(partition, size, refused.value.forbidden))
+        partition, quantize.blocks_on(partition, refused.value.edges))
     sides = quantize.side_counts(partition, counts)
     for b in set(range(len(partition.blocks))) - set(given_up):
         assert sides[b][0] == sides[b][2] and sides[b][1] == sides[b][3]

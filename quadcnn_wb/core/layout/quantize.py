@@ -163,11 +163,13 @@ class InfeasibleCounts(PartitionError):
     """No counts make every block's opposite sides equal (HiGHS: the model is infeasible).
     ``forbidden``: the rows against pinches the solves had found by then (variable
     positions, at least one segment among each row's): they hold for any counts, blocks
-    given up or not, so a program that may give blocks up starts from them."""
+    given up or not, so a program that may give blocks up starts from them.  ``edges``:
+    the partition's edges those rows' variables count."""
 
-    def __init__(self, message: str, forbidden=()):
+    def __init__(self, message: str, forbidden=(), edges=frozenset()):
         super().__init__(message)
         self.forbidden = [list(row) for row in forbidden]
+        self.edges = frozenset(edges)
 
 
 MILP_SECONDS = 60.0  # per solve; past it the counts are refused, not taken unproven
@@ -188,13 +190,13 @@ def quantize_freeing(partition: Partition, size: float,
     try:
         return _solve(partition, size, time_limit, free_blocks=False)
     except InfeasibleCounts as exc:
-        forbidden = exc.forbidden
+        forbidden, pinched = exc.forbidden, exc.edges
     # The blocks the elastic program leaves unequal, and those whose counts the rows
     # against pinches hold (balanced, the counts may still pinch: nist_ctc04_plate's
     # 2048-node layout once squared holes' lines left straight, all blocks balanced, a
     # pinch in every balanced solution).
     suspects = set(_unequal_blocks(partition, size, time_limit) or ()) \
-        | _blocks_of_variables(partition, size, forbidden)
+        | blocks_on(partition, pinched)
     if suspects:
         # The fewest blocks to give up, chosen among those and their neighbours only:
         # exact where it counts, and fast (a program that may give up any of 1000 blocks
@@ -209,13 +211,8 @@ def quantize_freeing(partition: Partition, size: float,
     return _solve(partition, size, time_limit, free_blocks=True, forbidden=forbidden)
 
 
-def _blocks_of_variables(partition: Partition, size: float, rows) -> set:
-    """The blocks with a side on an edge whose count variable is in one of ``rows``."""
-    if not rows:
-        return set()
-    position = _base(partition, size).position
-    edges = {e for e in range(len(partition.edges))
-             if int(position[e]) in {v for row in rows for v in row}}
+def blocks_on(partition: Partition, edges) -> set:
+    """The blocks with a side on one of ``edges``."""
     return {b for b, block in enumerate(partition.blocks)
             if any(e in edges for side in block.sides for e, _ in side)}
 
@@ -223,8 +220,7 @@ def _blocks_of_variables(partition: Partition, size: float, rows) -> set:
 def _with_neighbours(partition: Partition, blocks) -> set:
     """The blocks and every block that shares an edge with one of them."""
     edges = {e for b in blocks for side in partition.blocks[b].sides for e, _ in side}
-    return set(blocks) | {b for b, block in enumerate(partition.blocks)
-                          if any(e in edges for side in block.sides for e, _ in side)}
+    return set(blocks) | blocks_on(partition, edges)
 
 
 @dataclass
@@ -404,8 +400,10 @@ def _solve(partition: Partition, size: float, time_limit: float, free_blocks,
             unstretched, stretching = [], False  # they cost blocks: as before them
             continue
         if result.x is None and result.status == 2:  # proven infeasible
+            edge_of = np.argsort(position)  # variable v counts edge edge_of[v]
             raise InfeasibleCounts(f"no segment counts make opposite block sides equal "
-                                   f"({result.message})", forbidden)
+                                   f"({result.message})", forbidden,
+                                   {int(edge_of[v]) for row in forbidden for v in row})
         if result.status != 0:  # a time-limited answer would depend on the machine's speed
             raise PartitionError(f"the segment-count program found no proven optimum "
                                  f"within {time_limit:g} s ({result.message})")

@@ -95,19 +95,19 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
         centre = np.mean([vertices[t] for t in targets] + [vertices[c] for c in convex],
                          axis=0)
         key = split_key(vertices, corners)
-        if key not in unsplit and not _centre_sees(vertices, edges, corners, sides, reflex,
+        outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
+        if key not in unsplit and not _centre_sees(vertices, outline, corners, reflex,
                                                    centre, targets) \
                 and (reflex or k >= 6):
             # The mean of a concave face's corners may not see them all; the middle of
             # the face's kernel (what sees all of its outline) does where there is one.
-            outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
             kernel = _kernel(outline)
             if kernel is not None:
                 centre = kernel
         if key not in unsplit:
-            centre = _centre_inside(vertices, edges, sides, centre, targets, convex)
-        if key in unsplit or not _centre_sees(vertices, edges, corners, sides, reflex,
-                                              centre, targets):
+            centre = _centre_inside(vertices, outline, centre, targets, convex)
+        if key in unsplit or not _centre_sees(vertices, outline, corners, reflex, centre,
+                                              targets):
             halves = [h for side in sides for h in side]
             why = "whose split could not be filled" if key in unsplit \
                 else "is too concave to split into quadrilaterals"
@@ -186,33 +186,33 @@ def _kernel(outline):
     return poly.mean(axis=0)
 
 
-def _centre_sees(vertices, edges, corners, sides, reflex, centre, targets) -> bool:
+def _centre_sees(vertices, outline, corners, reflex, centre, targets) -> bool:
     """Whether the spokes from the centre can go in: the centre inside the corners'
     polygon, and (in a face with reflex corners or more than six) every spoke inside the
-    face."""
+    face's ``outline``."""
     if not inside_polygon(np.array([vertices[c] for c in corners]), centre):
         return False
-    if not reflex and len(corners) < 6:
-        return True
-    outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
+    return (not reflex and len(corners) < 6) or _spokes_inside(vertices, outline, centre,
+                                                                targets)
+
+
+def _spokes_inside(vertices, outline, centre, targets) -> bool:
     return all(_inside(outline, centre, np.asarray(vertices[t])) for t in targets)
 
 
 CENTRE_SHIFTS = (0.25, 0.5)  # of the way from the centre to a corner or target, tried
 
 
-def _centre_inside(vertices, edges, sides, centre, targets, convex) -> np.ndarray:
+def _centre_inside(vertices, outline, centre, targets, convex) -> np.ndarray:
     """``centre``, or where its spokes would leave the face (a side that is a boundary
     curve bulging in: held-out 0095's 8192-node layout had a five-cornered face's centre
     beside such a curve, a spoke across it, and the block's map folded) the nearest point
     whose spokes stay inside, tried a quarter and half of the way to each corner and
     target (nearest first, by distances rounded well above round-off, which every pose
     shares); ``centre`` as it was where none is."""
-    outline = np.vstack([_side_points(side, edges)[:-1] for side in sides])
-
     def sees(point) -> bool:
-        return inside_polygon(outline, point) and all(
-            _inside(outline, point, np.asarray(vertices[t])) for t in targets)
+        return inside_polygon(outline, point) and _spokes_inside(vertices, outline, point,
+                                                                 targets)
 
     if sees(centre):
         return centre
