@@ -92,9 +92,13 @@ def test_every_face_is_block_structured(name):
 # ends read as corners with four quads; 59 irregular vertices against gmsh's 179);
 # perforated_plate's 29, where the lines of its 89 squared holes' corners end on each
 # other (389 against gmsh's 786; all blocks at the default size since those lines leave
-# straight along the squares' sides: 0.97 before).
+# straight along the squares' sides: 0.97 before); nist_ctc01_plate's two 270° notch
+# corners, each with a valence-3 point an element off whose lens (layout.lenses) became one
+# line: the corner has two quads where its angle asks three, the point is regular (its
+# 2048-node layout is all blocks since: 62 irregular vertices and worst 0.86 against the
+# 8192-node layout's 60 and 0.85, in 0.6 s against 1.4 s).
 KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyhole_plate": 2,
-                         "nist_ctc04_plate": 4,
+                         "nist_ctc04_plate": 4, "nist_ctc01_plate": 2,
                          "crankshaft_web_keyway": 2, "blend_horn_square": 1,
                          "blend_slotted_plate": 4, "perforated_plate": 29}
 
@@ -278,14 +282,15 @@ def test_a_part_whose_features_the_background_misses_is_laid_out_on_a_finer_one(
 
 
 @pytest.mark.parametrize("name, divisor, finished, good_enough", [
-    ("nist_ctc01_plate", None, [8192], None),
+    ("sketch_keyhole_plate", None, [8192], None),
     ("nist_ctc04_plate", None, [8192, 2048], (1.01, 0.2)),
     ("nist_ctc04_plate", None, [8192], None)])
 def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_some(
         monkeypatch, name, divisor, finished, good_enough):
     # The freeing rounds and unstructured fills of a layout that leaves free faces cost
-    # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s), so they wait for
-    # it: nist_ctc01_plate's and nist_ctc04_plate's finer layouts are all blocks.  No
+    # more than the finer try (nist_ctc01_plate: 3.5 s against 0.8 s, before its first
+    # layout was all blocks), so they wait for it: sketch_keyhole_plate's and
+    # nist_ctc04_plate's finer layouts are all blocks.  No
     # corpus part's finer layout is under GOOD_ENOUGH any more; asked for more than all
     # blocks, nist_ctc04_plate's first layout is finished too (from its own streamlines).
     from quadcnn_wb.core import pipeline

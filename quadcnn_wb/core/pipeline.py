@@ -22,6 +22,7 @@ from .input.pose import default_size
 from .input.small_holes import squared_holes
 from .layout.cusps import tip_corners, with_cusp_kites
 from .layout.cuts import connecting_cuts
+from .layout.lenses import without_short_lenses
 from .layout.motorcycle import stop_at_first_hits
 from .layout.partition import STAR_CORNERS, build_partition, corners_instead_of_4
 from .layout.partition_types import (
@@ -312,9 +313,10 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
 
 
 def _t_mesh(domain, background, field, lines, size) -> tuple:
-    """Traces cut where they first meet an earlier one (see layout.motorcycle), none in a
-    sliver wedge at a corner (layout.wedges), and a kite at each cusp's tip
-    (layout.cusps)."""
+    """One line for each short lens (layout.lenses), traces cut where they first meet an
+    earlier one (see layout.motorcycle), none in a sliver wedge at a corner
+    (layout.wedges), and a kite at each cusp's tip (layout.cusps)."""
+    lines = without_short_lenses(lines, background.element_size)
     lines = stop_at_first_hits(lines, background.element_size, 1e-9 * domain.size)
     lines = without_corner_wedges(domain, background, lines, size)
     return with_cusp_kites(domain, background, field, lines, size)

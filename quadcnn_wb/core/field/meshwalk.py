@@ -12,6 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 MAX_WALK = 64
+INSIDE_TOL = 1e-10  # a point this near (of the mesh's extent) a triangle's side is in it:
+# a hundred times the layout frame's rounding (layout_frame.FRAME_DIGITS), so a trace that
+# runs along a boundary edge (a slot's tip read as one corner sends lines along its short
+# side) is inside in every copy of the part, not inside or out by a last bit (held-out
+# 0043: one end of such a side rounded 1e-12 off the other's x, and a turned copy lost
+# the line)
 
 
 def triangle_neighbours(triangles: np.ndarray) -> np.ndarray:
@@ -42,6 +48,12 @@ class MeshWalker:
         # (np.linalg.inv on thousands of tiny matrices costs more than the whole walk).
         e1, e2 = b - a, c - a
         det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        # Barycentric coordinate k is the distance from the side opposite vertex k over
+        # that vertex's height: the tolerance per coordinate is INSIDE_TOL over it.
+        sides = np.stack([np.hypot(*(c - b).T), np.hypot(*(c - a).T), np.hypot(*(b - a).T)],
+                         axis=1)
+        extent = float(np.hypot(*np.ptp(nodes, axis=0))) if len(nodes) else 1.0
+        self.inside_tol = INSIDE_TOL * extent * sides / np.abs(det)[:, None]
         self.inverse = np.stack([np.stack([e2[:, 1], -e2[:, 0]], axis=1),
                                  np.stack([-e1[:, 1], e1[:, 0]], axis=1)], axis=1) / det[:, None,
                                                                                          None]
@@ -50,8 +62,8 @@ class MeshWalker:
         uv = np.einsum("nij,nj->ni", self.inverse[tri], p - self.origin[tri])
         return np.column_stack([1.0 - uv.sum(axis=1), uv])
 
-    def locate(self, tri: np.ndarray, p: np.ndarray, tol: float = 1e-12):
-        """Walk from ``tri`` to the triangle holding each point.
+    def locate(self, tri: np.ndarray, p: np.ndarray):
+        """Walk from ``tri`` to the triangle holding each point (within INSIDE_TOL).
 
         Returns (triangle, barycentric, exit_edge): triangle is -1 for a point that was
         walked out of the domain, and exit_edge then holds (triangle, local edge) of the
@@ -65,8 +77,8 @@ class MeshWalker:
             if not len(active):
                 break
             b = self.barycentric(tri[active], p[active])
+            inside = (b >= -self.inside_tol[tri[active]]).all(axis=1)
             worst = np.argmin(b, axis=1)
-            inside = b[np.arange(len(active)), worst] >= -tol
             bary[active[inside]] = b[inside]
             moving = active[~inside]
             edge = worst[~inside]

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .curves import Arc, Line, curve_bbox, diameter_of, loop_signed_area, winding_number
-from .healing import HEAL_TOL, drop_crumbs, merge_curves, report_gaps
+from .healing import HEAL_TOL, arcs_through_their_ends, drop_crumbs, merge_curves, report_gaps
 from .intersections import Overlap, curve_intersections
 
 CLOSE_TOL = 1e-9  # relative to the domain size: what counts as exact
@@ -147,7 +147,7 @@ def make_domain(loops, units: str = "mm") -> Domain:
     for li, loop in enumerate(curves):
         _check_loop_shape(loop, li, eps, heal)
     report_gaps(curves, eps, notes)
-    curves = [merge_curves(_close_loop(loop), li, heal, notes)
+    curves = [arcs_through_their_ends(merge_curves(_close_loop(loop), li, heal, notes), size)
               for li, loop in enumerate(curves)]
     for li, loop in enumerate(curves):
         _check_not_flat(loop, li, eps)

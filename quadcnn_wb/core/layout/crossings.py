@@ -19,6 +19,12 @@ def point_at(points: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
     return points[k] + min(max(f, 0.0), 1.0) * (points[k + 1] - points[k])
 
 
+def resampled(points: np.ndarray, n: int) -> np.ndarray:
+    """``n`` points at equal arc length along the polyline, its ends included."""
+    cum = cumulative_length(points)
+    return np.array([point_at(points, cum, s) for s in np.linspace(0.0, cum[-1], n)])
+
+
 def end_places(line) -> list:
     """(point, places) at both ends of a streamline: the singular point or corner it leaves
     or reaches, or ("line", j) when it ends on line j."""

@@ -129,7 +129,7 @@ def arrives_along(alignment):
 # One line per separatrix
 
 
-def claim_separatrices(lengths, starts, ends, joining=frozenset()) -> tuple[list, dict]:
+def claim_separatrices(lengths, starts, ends, joining=frozenset(), ties=None) -> tuple[list, dict]:
     """(indices of the lines to keep, sorted; {kept line: line holding its end slot}).
 
     A line from source a that arrives at b along b's separatrix k *is* that separatrix
@@ -139,8 +139,10 @@ def claim_separatrices(lengths, starts, ends, joining=frozenset()) -> tuple[list
     start slot is still free but whose end slot is taken still stays (its own
     separatrix would be missing otherwise), joined to the line holding that slot.
     Lines in ``joining`` claim no end slot: kept, they are joined to its holder.
+    ``ties``: a key per line that orders lines of equal length (else their order).
     """
-    order = sorted(range(len(lengths)), key=lambda i: lengths[i])
+    order = sorted(range(len(lengths)),
+                   key=lambda i: (lengths[i], ties[i] if ties is not None else (), i))
     owner, keep, joins = {}, set(), {}
     for i in order:
         mine = {starts[i], None if i in joining else ends[i]} - {None}
@@ -176,10 +178,15 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
         return (e.kind, e.index, e.branch) if e.branch >= 0 else None
 
     lines = _along_own_separatrices(_arrival_branches(_ended_on_passed_points(lines, h), h), h)
-    final, joins = claim_separatrices([line.length for line in lines],
+    # Lengths equal but for round-off (a line from corner a to corner b and one from b to
+    # a, three points each: held-out 0078 at diameter/100, whose turned copy kept the
+    # other one) are equal, and the lower-numbered start claims first: corner nodes and
+    # singular points are numbered alike in every pose, the traces are not ordered alike.
+    final, joins = claim_separatrices([round(line.length / h, LENGTH_DIGITS) for line in lines],
                                       [slot(line.start) for line in lines],
                                       [slot(line.end) for line in lines],
-                                      _sideways_into_corners(lines, h))
+                                      _sideways_into_corners(lines, h),
+                                      [(_place(line.start), _place(line.end)) for line in lines])
     position = {i: k for k, i in enumerate(final)}
     out = []
     for i in final:
@@ -188,6 +195,13 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
             line = _join(line, lines[joins[i]], position[joins[i]], h)
         out.append(line)
     return out
+
+
+LENGTH_DIGITS = 6  # line lengths are compared in element sizes to this many decimals
+
+
+def _place(end) -> tuple:
+    return (end.kind, end.index) if end.kind in ("corner", "singularity") else ("", -1)
 
 
 def _sideways_into_corners(lines, h) -> set:
@@ -434,7 +448,7 @@ def _join(line: Streamline, other: Streamline, other_index: int, h: float) -> St
     if not len(close):
         return line
     head = int(close[0])
-    point, param = _nearest_on_polyline(other.points, line.points[head])
+    point, param = nearest_on_polyline(other.points, line.points[head])
     return dataclasses.replace(line, points=np.vstack([line.points[:head], point]),
                                end=Endpoint("streamline", other_index, param=param))
 
@@ -446,7 +460,7 @@ def _densify(points, spacing):
     return np.vstack(parts + [points[-1:]])
 
 
-def _nearest_on_polyline(points, p):
+def nearest_on_polyline(points, p):
     """Closest point to p on the polyline, and its arc-length fraction along it."""
     a, b = points[:-1], points[1:]
     d = b - a

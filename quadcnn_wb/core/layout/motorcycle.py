@@ -43,6 +43,27 @@ class _Rider:
     hit: tuple = None  # (rider it stopped on, position along that rider, point)
 
 
+TIME_TIE = 1e-6  # element sizes: two riders reaching a crossing this close in time are
+# there at once (two traces from neighbouring corners of a knurled rim crossing half-way:
+# held-out 0078 at diameter/100, where round-off chose which stopped, and a turned copy
+# chose the other)
+TIME_DIGITS = 6  # events are ordered by time in element sizes to this many decimals, then
+# by rank
+
+
+def _rank(line, backward: bool, rider: int) -> tuple:
+    """The order of riders at a tie: by the places they leave and head for (corner nodes
+    and singular points are numbered alike in every pose; the traces are not ordered
+    alike), then by their order."""
+    ends = (_place(line.end), _place(line.start)) if backward else \
+        (_place(line.start), _place(line.end))
+    return ends + (rider,)
+
+
+def _place(end) -> tuple:
+    return (end.kind, end.index) if end.kind in SOURCE_KINDS else ("", -1)
+
+
 def _riders(lines) -> list:
     riders = []
     for k, line in enumerate(lines):
@@ -84,13 +105,20 @@ def stop_at_first_hits(lines, h: float, tol: float) -> tuple:
                              line.end.param * length[line.end.index], length[line.end.index])
             riders[j].keep_to = max(riders[j].keep_to, s)
     ends = _rider_ends(lines, riders, by_line)
+    rank = [_rank(lines[r.line], r.backward, k) for k, r in enumerate(riders)]
+    tie = TIME_TIE * h
     events = []
     for (i, si), (j, sj), xy in crossings([r.points for r in riders], h, tol, ends):
-        if si > sj:
+        if abs(si - sj) <= tie:  # at once: the rider ranked later stops
+            if rank[i] > rank[j]:
+                events.append((si, i, j, sj, xy))
+            else:
+                events.append((sj, j, i, si, xy))
+        elif si > sj:
             events.append((si, i, j, sj, xy))
-        elif sj > si:
+        else:
             events.append((sj, j, i, si, xy))
-    events.sort(key=lambda e: (e[0], e[1], e[2]))
+    events.sort(key=lambda e: (round(e[0] / h, TIME_DIGITS), rank[e[1]], rank[e[2]]))
     for s_late, late, early, s_early, xy in events:
         r = riders[late]
         if s_late >= r.stop or s_late < r.keep_to or s_early >= riders[early].stop:

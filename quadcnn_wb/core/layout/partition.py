@@ -24,7 +24,7 @@ import numpy as np
 
 from ..input.corners import interior_angle
 from ..input.features import is_smooth_join
-from .crossings import crossings, cumulative_length, end_places, point_at
+from .crossings import crossings, cumulative_length, end_places, point_at, resampled
 from .partition_types import (
     BoundaryPiece,
     Edge,
@@ -359,14 +359,9 @@ def _without_doubles(edges, h, order) -> list:
 
 
 def _side_by_side(first: Edge, second: Edge, gap: float) -> bool:
-    a = _resampled(first.points, 9)
-    b = _resampled(second.points if second.a == first.a else second.points[::-1], 9)
+    a = resampled(first.points, 9)
+    b = resampled(second.points if second.a == first.a else second.points[::-1], 9)
     return bool(np.hypot(*(a - b).T).max() <= gap)
-
-
-def _resampled(points, n: int) -> np.ndarray:
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
-    return np.array([point_at(points, cum, s) for s in np.linspace(0.0, cum[-1], n)])
 
 
 def _without_dangling(edges) -> list:

@@ -1,0 +1,54 @@
+"""Decisions between equals are made by geometry every copy of a part shares, never by
+round-off or by the order of the traces (a turned copy's traces differ in their last bits
+and may come in another order)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from quadcnn_wb.core.layout.field_rules import one_line_per_separatrix
+from quadcnn_wb.core.layout.motorcycle import stop_at_first_hits
+from quadcnn_wb.core.layout.streamlines import Endpoint, Streamline
+
+
+def _corner(node, branch=-1):
+    return Endpoint("corner", node, 0, node, 0.5, branch)
+
+
+def _between(a, b, a_node, b_node, bend, wobble=0.0):
+    """A three-point line from corner a_node to corner b_node (arriving along no branch:
+    a corner's line is claimed by its start)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    middle = 0.5 * (a + b) + np.array([bend, wobble])
+    return Streamline(np.array([a, middle, b]), _corner(a_node, 0), _corner(b_node, 0))
+
+
+@pytest.mark.parametrize("wobble", [-1e-13, 0.0, 1e-13])
+@pytest.mark.parametrize("order", [0, 1])
+def test_of_two_lines_between_two_corners_each_way_the_lower_numbered_start_stays(
+        wobble, order):
+    # 0078 at diameter/100: a line from corner 419 to corner 356 and one back, equal
+    # in length but for the last bits; the turned copy kept the other one.
+    there = _between([0.0, 0.0], [0.0, 1.0], 419, 356, 0.1, wobble)
+    back = _between([0.0, 1.0], [0.0, 0.0], 356, 419, 0.1)
+    lines = [there, back] if order == 0 else [back, there]
+    kept = one_line_per_separatrix(lines, 1.0)
+    assert [line.start.index for line in kept] == [356]
+
+
+def _crossing(shift, order):
+    """Two straight lines from corners 7 and 3 that cross where each has run 1.0."""
+    first = Streamline(np.array([[0.0, 0.0], [2.0, 2.0]]) / np.sqrt(2.0) + [0.0, shift],
+                       _corner(7, 0), Endpoint("boundary", -1, 0, 1, 0.2))
+    second = Streamline(np.array([[np.sqrt(2.0), 0.0], [-np.sqrt(2.0) / 2, np.sqrt(2.0) * 1.5]])
+                        / 1.0, _corner(3, 0), Endpoint("boundary", -1, 0, 2, 0.7))
+    return [first, second] if order == 0 else [second, first]
+
+
+@pytest.mark.parametrize("shift", [-1e-13, 0.0, 1e-13])
+@pytest.mark.parametrize("order", [0, 1])
+def test_two_traces_reaching_their_crossing_at_once_stop_alike_in_every_copy(shift, order):
+    lines = stop_at_first_hits(_crossing(shift, order), 1.0, 1e-9)
+    stopped = [line.start.index for line in lines if line.end.kind == "streamline"]
+    assert stopped == [7]  # the later in rank (corner 7 after corner 3) stops
