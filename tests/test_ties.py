@@ -52,3 +52,42 @@ def test_two_traces_reaching_their_crossing_at_once_stop_alike_in_every_copy(shi
     lines = stop_at_first_hits(_crossing(shift, order), 1.0, 1e-9)
     stopped = [line.start.index for line in lines if line.end.kind == "streamline"]
     assert stopped == [7]  # the later in rank (corner 7 after corner 3) stops
+
+
+def _short_edge_index(mirrored: bool):
+    """The boundary index of a square with a chamfer 0.5 sizes long at one corner (a
+    unit test of the end rule alone: no background mesh, no features)."""
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.layout.tracing import _BoundaryIndex
+
+    pts = [[0.0, 0.0], [10.0, 0.0], [10.0, 9.8], [9.8, 10.0], [0.0, 10.0]]
+    if mirrored:
+        pts = [[-x, y] for x, y in pts[::-1]]
+    loop = [{"line": [a, b]} for a, b in zip(pts, pts[1:] + pts[:1])]
+    domain = domain_from_json({"loops": [loop]})
+    index = object.__new__(_BoundaryIndex)
+    index.domain, index.inner_corners, index.flat_joints = domain, {}, frozenset()
+    index.corner_nodes = set()
+    # vertex nodes numbered by place, as the background (the same in every pose) numbers
+    index.vertex_node = {(0, k): 100 + int(round(abs(c.p0[0]) * 7 + c.p0[1] * 13))
+                         for k, c in enumerate(domain.loops[0])}
+    return domain, index
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_an_end_on_a_curve_shorter_than_two_snaps_goes_to_its_nearer_end(mirrored):
+    # 0095 at diameter/100: a trace left the domain on a hole's arc 0.37 of a size long,
+    # within the corner snap of both its ends; it went to the arc's start, and its mirror
+    # image, which walks the arc the other way, to the other end.
+    domain, index = _short_edge_index(mirrored)
+    loop = domain.loops[0]
+    si = next(k for k, c in enumerate(loop) if c.length < 1.0)
+    chamfer = loop[si]
+    h = chamfer.length / 0.5  # the chamfer is half a size long
+    near = np.array([-9.8 if mirrored else 9.8, 10.0])
+    far = chamfer.p0 if np.allclose(chamfer.p1, near) else chamfer.p1
+    # 0.22 sizes from the joint at (9.8, 10), 0.28 from the other one: within the snap
+    # (0.3 sizes) of both
+    t = chamfer.project(near + 0.44 * (far - near))
+    _, xy = index.endpoint(0, si, t, h)
+    assert np.allclose(xy, near)

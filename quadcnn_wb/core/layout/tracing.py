@@ -100,11 +100,17 @@ class _BoundaryIndex:
         # Not onto a joint read as flat (a step's or a knurl's, input.features): no mesh
         # node need sit there, and one that did would have the joint's own angle (a
         # knurled rim's tooth corner of 118° with two quads: an irregular vertex).
-        if along <= CORNER_SNAP * element and (li, si) not in self.flat_joints:
+        near_start = along <= CORNER_SNAP * element and (li, si) not in self.flat_joints
+        nxt = (si + 1) % len(loop)
+        near_end = curve.length - along <= CORNER_SNAP * element \
+            and (li, nxt) not in self.flat_joints
+        if near_start and near_end:  # a curve shorter than two snaps: its nearer end
+            near_start = self._start_is_nearer(along, curve.length - along, element,
+                                               (li, si), (li, nxt))
+        if near_start:
             t = 0.0
-        elif curve.length - along <= CORNER_SNAP * element \
-                and (li, (si + 1) % len(loop)) not in self.flat_joints:
-            li, si, t = li, (si + 1) % len(loop), 0.0
+        elif near_end:
+            li, si, t = li, nxt, 0.0
             curve = loop[si]
         if t == 0.0:
             node = self.vertex_node.get((li, si), -1)
@@ -113,6 +119,17 @@ class _BoundaryIndex:
             if node < 0:  # not a vertex after all (a circle's seam)
                 t = max(t, 0.0)
         return Endpoint("boundary", -1, li, si, float(t)), curve.point(t)
+
+    def _start_is_nearer(self, to_start, to_end, element, start, end) -> bool:
+        """Of a short curve's two ends, the nearer; a tie goes to the lower-numbered
+        vertex node.  Not always its start: a mirrored copy walks every curve the other
+        way (held-out 0095 at diameter/100: a separatrix leaving the domain on a hole's
+        arc of 0.37 of a size ended on the arc's start, its mirror image's on the other
+        end)."""
+        a, b = round(to_start / element, 9), round(to_end / element, 9)
+        if a != b:
+            return a < b
+        return self.vertex_node.get(start, -1) <= self.vertex_node.get(end, -1)
 
     def nearest(self, p) -> int:
         return int(self.boundary_nodes[self.tree.query(p)[1]])
