@@ -200,8 +200,10 @@ ON_CIRCLE = 1e-8  # relative to the part's size: an arc end this near its circle
 
 
 def arcs_through_their_ends(loop, size: float) -> list:
-    """Each arc whose ends healing moved (a joined gap, a merged run's averaged circle)
-    is replaced by the arc through its ends and its old middle.
+    """Each arc whose ends are off its circle by more than ON_CIRCLE (healing moved them:
+    a joined gap, a merged run's averaged circle; or a CAD kernel's vertex lies within
+    its tolerance of the curve) is replaced by the arc through its ends and its old
+    middle.
 
     An arc is stored by its circle and its ends; one whose ends are off its circle has
     a kink at each, and its JSON (ends and middle, DESIGN.md) reads back as another

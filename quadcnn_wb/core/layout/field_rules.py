@@ -186,7 +186,7 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
                                       [slot(line.start) for line in lines],
                                       [slot(line.end) for line in lines],
                                       _sideways_into_corners(lines, h),
-                                      [(_place(line.start), _place(line.end)) for line in lines])
+                                      [(line.start.place, line.end.place) for line in lines])
     position = {i: k for k, i in enumerate(final)}
     out = []
     for i in final:
@@ -198,10 +198,6 @@ def one_line_per_separatrix(lines: list, h: float) -> list:
 
 
 LENGTH_DIGITS = 6  # line lengths are compared in element sizes to this many decimals
-
-
-def _place(end) -> tuple:
-    return (end.kind, end.index) if end.kind in ("corner", "singularity") else ("", -1)
 
 
 def _sideways_into_corners(lines, h) -> set:

@@ -27,7 +27,7 @@ import dataclasses
 import numpy as np
 
 from .crossings import resampled
-from .field_rules import nearest_on_polyline, shifted_tail
+from .field_rules import bent_to, nearest_on_polyline
 from .tracing import SNAP_BLEND
 
 LENS_LENGTH = 2.0  # element sizes: both lines of a lens at most this long
@@ -92,10 +92,8 @@ def _renumbered(lines, merged: dict, h: float) -> tuple:
             if target in means and 0.0 < end.param < 1.0:  # (0 or 1: on the mean's end)
                 place, param = nearest_on_polyline(np.asarray(lines[target].points),
                                                    line.points[-1])
-                points = shifted_tail(line.points, place - line.points[-1], SNAP_BLEND * h)
-                points = np.asarray(points, dtype=float)
-                points[-1] = place
-                line = dataclasses.replace(line, points=points)
+                line = dataclasses.replace(line,
+                                           points=bent_to(line.points, place, SNAP_BLEND * h))
                 end = dataclasses.replace(end, param=param)
             line = dataclasses.replace(line, end=dataclasses.replace(end, index=new_index[target]))
         out.append(line)

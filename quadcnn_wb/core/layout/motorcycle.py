@@ -55,13 +55,9 @@ def _rank(line, backward: bool, rider: int) -> tuple:
     """The order of riders at a tie: by the places they leave and head for (corner nodes
     and singular points are numbered alike in every pose; the traces are not ordered
     alike), then by their order."""
-    ends = (_place(line.end), _place(line.start)) if backward else \
-        (_place(line.start), _place(line.end))
+    ends = (line.end.place, line.start.place) if backward else \
+        (line.start.place, line.end.place)
     return ends + (rider,)
-
-
-def _place(end) -> tuple:
-    return (end.kind, end.index) if end.kind in SOURCE_KINDS else ("", -1)
 
 
 def _riders(lines) -> list:
@@ -109,15 +105,9 @@ def stop_at_first_hits(lines, h: float, tol: float) -> tuple:
     tie = TIME_TIE * h
     events = []
     for (i, si), (j, sj), xy in crossings([r.points for r in riders], h, tol, ends):
-        if abs(si - sj) <= tie:  # at once: the rider ranked later stops
-            if rank[i] > rank[j]:
-                events.append((si, i, j, sj, xy))
-            else:
-                events.append((sj, j, i, si, xy))
-        elif si > sj:
-            events.append((si, i, j, sj, xy))
-        else:
-            events.append((sj, j, i, si, xy))
+        # The later rider stops; of two there at once, the one ranked later.
+        i_stops = rank[i] > rank[j] if abs(si - sj) <= tie else si > sj
+        events.append((si, i, j, sj, xy) if i_stops else (sj, j, i, si, xy))
     events.sort(key=lambda e: (round(e[0] / h, TIME_DIGITS), rank[e[1]], rank[e[2]]))
     for s_late, late, early, s_early, xy in events:
         r = riders[late]

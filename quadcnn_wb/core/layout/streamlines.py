@@ -26,6 +26,13 @@ class Endpoint:
     def same_place(self, other) -> bool:
         return (self.kind, self.index) == (other.kind, other.index)
 
+    @property
+    def place(self) -> tuple:
+        """(kind, index) of a singular point or corner, numbered alike in every pose of
+        the part (the background's nodes and zeros); ("", -1) for any other end: what
+        ties between lines are decided by."""
+        return (self.kind, self.index) if self.kind in ("corner", "singularity") else ("", -1)
+
     def to_json(self) -> dict:
         out = {"kind": self.kind}
         if self.index >= 0:
