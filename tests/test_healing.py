@@ -5,11 +5,18 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 from conftest import rect, run_cli
 
-from quadcnn_wb.core.input.domain import DomainError, domain_from_json
-from quadcnn_wb.core.input.healing import HEAL_TOL
+from quadcnn_wb.core.input.curves import Line
+from quadcnn_wb.core.input.domain import DomainError, domain_from_json, make_domain
+from quadcnn_wb.core.input.healing import (
+    HEAL_TOL,
+    VERTEX_SNAP,
+    onto_shared_vertices,
+    vertex_note,
+)
 from quadcnn_wb.core.pipeline import mesh_domain
 
 L = lambda a, b: {"line": [a, b]}  # noqa: E731
@@ -209,3 +216,38 @@ def test_an_arc_whose_end_was_joined_reads_back_from_its_json_as_the_same_arc():
     a, b = mesh_domain(domain), mesh_domain(again)
     assert (a.quality["quads"], a.quality["irregular_vertices"]) == \
         (b.quality["quads"], b.quality["irregular_vertices"])
+
+
+def test_curve_ends_go_onto_the_vertices_their_cad_file_shares():
+    # A CAD edge whose ends lie off the vertices it shares with its neighbours (a
+    # kernel's vertex tolerance): moved there from beyond the gap tolerance (floor) up to
+    # the limit, and the moves are returned for the report.
+    pieces = [Line(np.array([0.0, 0.0]), np.array([5.0, 0.0])),
+              (np.array([5.0, 0.0]), np.array([7.5, 1.0]), np.array([10.0, 0.01]))]
+    moved, moves = onto_shared_vertices(pieces, [0.0, 0.02], [10.0, 0.0], 1e-3, 0.1)
+    assert np.allclose(moved[0].p0, [0.0, 0.02]) and np.allclose(moved[0].p1, [5.0, 0.0])
+    assert np.allclose(moved[-1][2], [10.0, 0.0]) and np.allclose(moved[-1][0], [5.0, 0.0])
+    assert moves == pytest.approx([0.02, 0.01])
+    assert "moved 2 curve end(s) onto the vertex" in vertex_note(0, moves)
+
+
+def test_ends_far_off_or_within_the_gap_tolerance_stay_where_they_are():
+    line = [Line(np.array([0.0, 0.0]), np.array([10.0, 0.0]))]
+    far, far_moves = onto_shared_vertices(line, [0.0, 0.5], None, 1e-3, 0.1)
+    near, near_moves = onto_shared_vertices(line, [0.0, 1e-4], None, 1e-3, 0.1)
+    assert far_moves == [] and near_moves == []
+    assert np.array_equal(far[0].p0, [0.0, 0.0]) and np.array_equal(near[0].p0, [0.0, 0.0])
+
+
+def test_a_vertex_gap_past_the_limit_is_still_an_open_loop():
+    # What is not moved is judged by validation as before: a real gap is refused.
+    loop = [L([0, 0], [300, 0]), L([300, 0], [300, 200]), L([300, 200], [0, 200]),
+            L([0, 200], [0, 0])]
+    pieces = [Line(np.array(c["line"][0], float), np.array(c["line"][1], float)) for c in loop]
+    size = math.hypot(300, 200)
+    kept, moves = onto_shared_vertices(pieces[:1], [0.0, 0.0], [300.0, 5.0],
+                                       HEAL_TOL * size, VERTEX_SNAP * size)
+    assert moves == []
+    with pytest.raises(DomainError, match=r"open loop"):
+        make_domain([kept + [Line(np.array([300.0, 5.0]), np.array([300.0, 200.0]))]
+                     + pieces[2:]])

@@ -16,6 +16,7 @@ import Part
 from ..core.input.arc_splines import DENSE, arc_spline
 from ..core.input.curves import Arc, Line, diameter_of
 from ..core.input.domain import DomainError, make_domain
+from ..core.input.healing import HEAL_TOL, VERTEX_SNAP, onto_shared_vertices, vertex_note
 
 
 def source_shape_and_placement(source):
@@ -95,13 +96,36 @@ def face_to_domain(face, placement, label="face", units="mm"):
         d = inverse.Rotation.multVec(v)
         return (d.x, d.y)
 
-    loops = []
+    loops, notes = [], []
     for wire in [face.OuterWire] + [w for w in face.Wires if not w.isSame(face.OuterWire)]:
-        loop = []
+        loop, moved = [], []
         for edge in wire.OrderedEdges:
-            loop.extend(_edge_pieces(edge, local, local_direction, tol, size))
+            # The importer's rule: ends go onto the vertices the wire's edges share.
+            start, end = (local(v.Point) if _shared(v, wire, edge) else None
+                          for v in _end_vertices(edge))
+            pieces, moves = onto_shared_vertices(
+                _edge_pieces(edge, local, local_direction, tol, size), start, end,
+                HEAL_TOL * size, VERTEX_SNAP * size)
+            loop.append(pieces)
+            moved.extend(moves)
+        if moved:
+            notes.append(vertex_note(len(loops), moved))
         loops.append(_chain(loop))
-    return make_domain(loops, units=units)
+    return make_domain(loops, units=units, healed=tuple(notes))
+
+
+def _end_vertices(edge) -> tuple:
+    """The edge's vertices at its start and at its end, matched by distance."""
+    first = edge.valueAt(edge.FirstParameter)
+    last = edge.valueAt(edge.LastParameter)
+    return (min(edge.Vertexes, key=lambda v: (v.Point - first).Length),
+            min(edge.Vertexes, key=lambda v: (v.Point - last).Length))
+
+
+def _shared(vertex, wire, edge) -> bool:
+    """Whether another edge of the wire has this vertex (the same topological vertex)."""
+    return any(not other.isSame(edge) and any(vertex.isSame(v) for v in other.Vertexes)
+               for other in wire.Edges)
 
 
 def _size_in_plane(face, inverse) -> float:
@@ -135,27 +159,34 @@ def _edge_pieces(edge, local, local_direction, tol, size):
     return arc_spline(points, tangents, size)
 
 
-def _chain(pieces):
-    """Orient the pieces of one wire so each starts where the previous ended."""
-    def ends(p):
-        return (p[0], p[2]) if isinstance(p, tuple) else (p.p0, p.p1)
+def _chain(edges):
+    """One wire's pieces, each edge's (in its parameter order) turned as a whole so that
+    it starts where the previous edge ended.  Edge by edge: the pieces of a B-spline the
+    wire runs against its parameter, judged one by one, came in reversed order (a fan
+    hub's blades: a 0.72 mm "gap" inside one edge)."""
+    def ends(pieces):
+        first, last = pieces[0], pieces[-1]
+        return (first[0] if isinstance(first, tuple) else first.p0,
+                last[2] if isinstance(last, tuple) else last.p1)
 
-    def flip(p):
-        return (p[2], p[1], p[0]) if isinstance(p, tuple) else p.reversed()
+    def flip(pieces):
+        return [(p[2], p[1], p[0]) if isinstance(p, tuple) else p.reversed()
+                for p in reversed(pieces)]
 
-    if len(pieces) < 2:
-        return pieces
-    out = [pieces[0]]
-    a0, b0 = ends(pieces[0])
-    a1, b1 = ends(pieces[1])
+    edges = [pieces for pieces in edges if pieces]
+    if len(edges) < 2:
+        return [p for pieces in edges for p in pieces]
+    out = [edges[0]]
+    a0, b0 = ends(edges[0])
+    a1, b1 = ends(edges[1])
     if min(np.hypot(*(a0 - a1)), np.hypot(*(a0 - b1))) < min(np.hypot(*(b0 - a1)),
                                                               np.hypot(*(b0 - b1))):
-        out[0] = flip(pieces[0])
-    for p in pieces[1:]:
+        out[0] = flip(edges[0])
+    for pieces in edges[1:]:
         end = ends(out[-1])[1]
-        a, b = ends(p)
-        out.append(p if np.hypot(*(a - end)) <= np.hypot(*(b - end)) else flip(p))
-    return out
+        a, b = ends(pieces)
+        out.append(pieces if np.hypot(*(a - end)) <= np.hypot(*(b - end)) else flip(pieces))
+    return [p for pieces in out for p in pieces]
 
 
 def to_global(placement, xy):

@@ -16,6 +16,7 @@ from ..gmsh_session import gmsh_session, silenced_stdio
 from .arc_splines import DENSE, arc_spline
 from .curves import Arc, Line, circumcenter, diameter_of
 from .domain import DomainError, make_domain
+from .healing import HEAL_TOL, VERTEX_SNAP, onto_shared_vertices, vertex_note
 
 EXACT_TOLERANCE = 1e-5  # a curve this close to a line or circle is taken as one (IGES
 #                         writers store circles as B-splines that are off by ~1e-6)
@@ -46,11 +47,45 @@ def read_cad_face(path) -> object:
         frame = _plane_frame(face)
         _, curve_lists = gmsh.model.occ.getCurveLoops(face)
         size = _face_size(curve_lists, frame)
-        loops = [_chain([piece for tag in tags
-                         for piece in _curve_pieces(abs(int(tag)), frame, size)])
-                 for tags in curve_lists]
-    loops.sort(key=lambda loop: -_extent(loop))  # holes lie inside: the outer loop is widest
-    return make_domain(loops, units="mm")
+        read = [_loop_pieces([abs(int(tag)) for tag in tags], frame, size)
+                for tags in curve_lists]
+    read.sort(key=lambda loop: -_extent(loop[0]))  # holes lie inside: the outer loop is widest
+    notes = [vertex_note(li, moved) for li, (_, moved) in enumerate(read) if moved]
+    return make_domain([loop for loop, _ in read], units="mm", healed=tuple(notes))
+
+
+def _loop_pieces(tags: list, frame, size: float) -> tuple[list, list]:
+    """(one loop's pieces, chained; the curve-end moves onto shared vertices).  Each
+    curve's ends go onto the vertices it shares with the loop's other curves (the file's
+    own topology), from beyond HEAL_TOL up to VERTEX_SNAP of the part
+    (healing.onto_shared_vertices)."""
+    ends = [_end_vertices(tag, frame) for tag in tags]
+    uses = {}
+    for pair in ends:
+        for vertex, _ in pair:
+            uses[vertex] = uses.get(vertex, 0) + 1
+    pieces, moved = [], []
+    for tag, pair in zip(tags, ends):
+        start, end = (xy if uses[vertex] > 1 else None for vertex, xy in pair)
+        curve, moves = onto_shared_vertices(_curve_pieces(tag, frame, size), start, end,
+                                            HEAL_TOL * size, VERTEX_SNAP * size)
+        pieces.extend(curve)
+        moved.extend(moves)
+    return _chain(pieces), moved
+
+
+def _end_vertices(tag: int, frame) -> tuple:
+    """((vertex tag, its xy) at the curve's start, the same at its end): the curve's
+    boundary points, matched to its ends by distance (one for a closed curve)."""
+    lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+    first, last = _to_plane(frame, gmsh.model.getValue(1, tag, [float(lo[0]), float(hi[0])]))
+    vertices = [(int(v), _to_plane(frame, gmsh.model.getValue(0, int(v), []))[0])
+                for _, v in gmsh.model.getBoundary([(1, tag)], oriented=False)]
+    if not vertices:
+        return ((-tag, None), (-tag, None))
+    at_start = min(vertices, key=lambda v: float(np.hypot(*(v[1] - first))))
+    at_end = min(vertices, key=lambda v: float(np.hypot(*(v[1] - last))))
+    return at_start, at_end
 
 
 def _first_line(exc) -> str:

@@ -129,18 +129,19 @@ def _parse_segment(seg, li: int, si: int):
     raise DomainError(f"{where}: unknown segment kind {kind!r} (expected line, arc or circle)")
 
 
-def make_domain(loops, units: str = "mm") -> Domain:
+def make_domain(loops, units: str = "mm", healed: tuple = ()) -> Domain:
     """Validate loops of curves and return the oriented Domain.
 
     Arcs may be given as curves or as (start, middle, end) point triples; the latter are
     checked for collinearity here, where the domain size that sets the tolerance is known.
     What CAD kernels leave within HEAL_TOL of the part's size is healed first (see
-    healing.py) and listed in ``Domain.healed``.
+    healing.py) and listed in ``Domain.healed``, after ``healed``: what the reader
+    healed already (curve ends moved onto the vertices a CAD file says they share).
     """
     size = _raw_size(loops)
     eps = CLOSE_TOL * size
     heal = HEAL_TOL * size
-    notes = []
+    notes = list(healed)
     loops = drop_crumbs(loops, heal, notes)
     curves = [[_make_arc(c, li, si, eps) if isinstance(c, tuple) else c
                for si, c in enumerate(loop)] for li, loop in enumerate(loops)]

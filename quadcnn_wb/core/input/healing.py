@@ -218,3 +218,62 @@ def arcs_through_their_ends(loop, size: float) -> list:
         out.append(c)
     return out
 
+
+
+# A curve end the CAD file joins to its neighbour's (one shared vertex) is moved onto
+# that vertex from up to this far, relative to the part's size: a kernel's vertex
+# tolerance covers such gaps (the fan hub's hexagonal bore in pythonocc's Ventilator.stp:
+# its edges end 0.014 mm, 7e-4 of the hub, off the vertices they share, and OCCT, gmsh
+# and FreeCAD take the wire as closed).  Below the finest element the mesher is asked
+# for (about 1e-3 of the part); ends with no shared vertex keep HEAL_TOL.
+VERTEX_SNAP = 1e-3
+
+
+def onto_shared_vertices(pieces: list, start, end, floor: float,
+                         limit: float) -> tuple[list, list]:
+    """(``pieces`` of one CAD edge with their first start moved onto the vertex ``start``
+    and their last end onto ``end``, the moves made).  An end moves only where its vertex
+    is given (shared with the next edge) and more than ``floor`` (what the joining of
+    gaps heals anyway: those parts stay exactly as they were) but at most ``limit`` away;
+    otherwise it stays, for validation to judge the gap.  Pieces are lines, arcs or point
+    triples."""
+    if not pieces or _is_loop(pieces[0]):
+        return pieces, []
+    out, moves = list(pieces), []
+    if start is not None:
+        gap = float(np.hypot(*(np.asarray(start) - _piece_ends(out[0])[0])))
+        if floor < gap <= limit:
+            out[0] = _with_start(out[0], np.asarray(start, dtype=float))
+            moves.append(gap)
+    if end is not None:
+        gap = float(np.hypot(*(np.asarray(end) - _piece_ends(out[-1])[1])))
+        if floor < gap <= limit:
+            out[-1] = _reversed(_with_start(_reversed(out[-1]), np.asarray(end, dtype=float)))
+            moves.append(gap)
+    return out, moves
+
+
+def vertex_note(li: int, moved: list) -> str:
+    """What healing says about the curve ends moved onto their shared vertices."""
+    return (f"loop {li}: moved {len(moved)} curve end(s) onto the vertex they share with "
+            f"the next curve in the CAD file (up to {max(moved):.3g} off it)")
+
+
+def _piece_ends(piece):
+    if isinstance(piece, tuple):
+        return np.asarray(piece[0], dtype=float), np.asarray(piece[-1], dtype=float)
+    return piece.p0, piece.p1
+
+
+def _is_loop(piece) -> bool:
+    return isinstance(piece, Arc) and piece.is_full
+
+
+def _with_start(piece, p0):
+    if isinstance(piece, tuple):
+        return (p0,) + tuple(piece[1:])
+    return piece.with_start(p0)
+
+
+def _reversed(piece):
+    return tuple(piece[::-1]) if isinstance(piece, tuple) else piece.reversed()
