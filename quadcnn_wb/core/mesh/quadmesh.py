@@ -224,7 +224,7 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
                              "corner", sorted({int(b) for b in owner[squashed] if b >= 0}))
     boundary = np.zeros(len(nodes), dtype=bool)
     boundary[list(boundary_ids)] = True
-    quads = counter_clockwise_quads(nodes, quads)
+    quads = _turned_by_block(nodes, quads, owner)
     if smoothing:
         nodes = improve_worst(smooth(nodes, quads, boundary), quads, boundary)
         if sj_batch(nodes[quads]).min() > 0:
@@ -240,6 +240,23 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
     free_owner = np.concatenate(free_owner) if free_owner else np.zeros(0, dtype=np.int64)
     return QuadMesh(nodes=nodes, quads=quads, block_of_quad=owner, boundary=boundary,
                     edge_nodes=edge_nodes, free_face_of_quad=free_owner)
+
+
+def _turned_by_block(nodes, quads, owner) -> np.ndarray:
+    """Quads counter-clockwise, each block's all one way: the way most of its area runs.
+    A quad its map lays inverted then stays inverted, for smoothing to mend; turned on
+    its own it looked fine to every check of a quad while it folded over its neighbours,
+    and smoothing made it finer still (a flange of Open CASCADE's samples at its default
+    size: thin strips along its sides, where a hole's arc bulged the middle row of the
+    map out of the strip, folded and given up: 64 % of it in blocks, worst 0.06; all in
+    blocks and 0.86 since).  A free face's quads are turned one by one (gmsh's)."""
+    out = counter_clockwise_quads(nodes, quads)
+    mapped = owner >= 0
+    if mapped.any():
+        area = signed_areas(nodes, quads[mapped])
+        clockwise = np.bincount(owner[mapped], weights=area)[owner[mapped]] < 0
+        out[mapped] = np.where(clockwise[:, None], quads[mapped][:, ::-1], quads[mapped])
+    return out
 
 
 def _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions) -> None:
