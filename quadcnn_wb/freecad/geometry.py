@@ -16,7 +16,14 @@ import Part
 from ..core.input.arc_splines import DENSE, arc_spline
 from ..core.input.curves import Arc, Line, diameter_of
 from ..core.input.domain import DomainError, make_domain
-from ..core.input.healing import HEAL_TOL, VERTEX_SNAP, onto_shared_vertices, vertex_note
+from ..core.input.healing import (
+    HEAL_TOL,
+    VERTEX_SNAP,
+    onto_shared_vertices,
+    piece_ends,
+    reversed_piece,
+    vertex_note,
+)
 
 
 def source_shape_and_placement(source):
@@ -99,9 +106,10 @@ def face_to_domain(face, placement, label="face", units="mm"):
     loops, notes = [], []
     for wire in [face.OuterWire] + [w for w in face.Wires if not w.isSame(face.OuterWire)]:
         loop, moved = [], []
+        uses = _vertex_uses(wire)
         for edge in wire.OrderedEdges:
             # The importer's rule: ends go onto the vertices the wire's edges share.
-            start, end = (local(v.Point) if _shared(v, wire, edge) else None
+            start, end = (local(v.Point) if uses[v.hashCode()] > 1 else None
                           for v in _end_vertices(edge))
             pieces, moves = onto_shared_vertices(
                 _edge_pieces(edge, local, local_direction, tol, size), start, end,
@@ -122,10 +130,15 @@ def _end_vertices(edge) -> tuple:
             min(edge.Vertexes, key=lambda v: (v.Point - last).Length))
 
 
-def _shared(vertex, wire, edge) -> bool:
-    """Whether another edge of the wire has this vertex (the same topological vertex)."""
-    return any(not other.isSame(edge) and any(vertex.isSame(v) for v in other.Vertexes)
-               for other in wire.Edges)
+def _vertex_uses(wire) -> dict:
+    """How many edge ends of the wire each topological vertex holds (by its hash, which
+    like isSame ignores orientation), counted once per wire: asked per edge end, a
+    thousand-edge gear took a million comparisons."""
+    uses = {}
+    for edge in wire.Edges:
+        for v in edge.Vertexes:
+            uses[v.hashCode()] = uses.get(v.hashCode(), 0) + 1
+    return uses
 
 
 def _size_in_plane(face, inverse) -> float:
@@ -165,13 +178,10 @@ def _chain(edges):
     wire runs against its parameter, judged one by one, came in reversed order (a fan
     hub's blades: a 0.72 mm "gap" inside one edge)."""
     def ends(pieces):
-        first, last = pieces[0], pieces[-1]
-        return (first[0] if isinstance(first, tuple) else first.p0,
-                last[2] if isinstance(last, tuple) else last.p1)
+        return piece_ends(pieces[0])[0], piece_ends(pieces[-1])[1]
 
     def flip(pieces):
-        return [(p[2], p[1], p[0]) if isinstance(p, tuple) else p.reversed()
-                for p in reversed(pieces)]
+        return [reversed_piece(p) for p in reversed(pieces)]
 
     edges = [pieces for pieces in edges if pieces]
     if len(edges) < 2:

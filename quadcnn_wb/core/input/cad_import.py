@@ -16,7 +16,14 @@ from ..gmsh_session import gmsh_session, silenced_stdio
 from .arc_splines import DENSE, arc_spline
 from .curves import Arc, Line, circumcenter, diameter_of
 from .domain import DomainError, make_domain
-from .healing import HEAL_TOL, VERTEX_SNAP, onto_shared_vertices, vertex_note
+from .healing import (
+    HEAL_TOL,
+    VERTEX_SNAP,
+    onto_shared_vertices,
+    piece_ends,
+    reversed_piece,
+    vertex_note,
+)
 
 EXACT_TOLERANCE = 1e-5  # a curve this close to a line or circle is taken as one (IGES
 #                         writers store circles as B-splines that are off by ~1e-6)
@@ -162,14 +169,6 @@ def _curve_pieces(tag: int, frame, part_size: float) -> list:
     return arc_spline(at(us), tangents, part_size)
 
 
-def _endpoints(piece):
-    return (piece[0], piece[2]) if isinstance(piece, tuple) else (piece.p0, piece.p1)
-
-
-def _reverse(piece):
-    return (piece[2], piece[1], piece[0]) if isinstance(piece, tuple) else piece.reversed()
-
-
 def _chain(pieces: list) -> list:
     """Order and orient a loop's curves so each starts where the previous one ends: the
     nearest free end next (ties: the earlier piece, its start before its end), found for
@@ -177,15 +176,15 @@ def _chain(pieces: list) -> list:
     if len(pieces) == 1:
         return pieces
     ends = np.array([np.concatenate([np.asarray(a, dtype=float), np.asarray(b, dtype=float)])
-                     for a, b in map(_endpoints, pieces)])  # (n, 4): start xy, end xy
+                     for a, b in map(piece_ends, pieces)])  # (n, 4): start xy, end xy
     remaining = list(range(1, len(pieces)))
     chain = [pieces[0]]
     while remaining:
-        end = np.asarray(_endpoints(chain[-1])[1], dtype=float)
+        end = np.asarray(piece_ends(chain[-1])[1], dtype=float)
         candidates = ends[remaining].reshape(-1, 2)  # start, end of each remaining piece
         k = int(np.argmin(np.hypot(*(candidates - end).T)))
         piece = pieces[remaining.pop(k // 2)]
-        chain.append(_reverse(piece) if k % 2 else piece)
+        chain.append(reversed_piece(piece) if k % 2 else piece)
     return chain
 
 

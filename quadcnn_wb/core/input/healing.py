@@ -219,7 +219,6 @@ def arcs_through_their_ends(loop, size: float) -> list:
     return out
 
 
-
 # A curve end the CAD file joins to its neighbour's (one shared vertex) is moved onto
 # that vertex from up to this far, relative to the part's size: a kernel's vertex
 # tolerance covers such gaps (the fan hub's hexagonal bore in pythonocc's Ventilator.stp:
@@ -241,14 +240,15 @@ def onto_shared_vertices(pieces: list, start, end, floor: float,
         return pieces, []
     out, moves = list(pieces), []
     if start is not None:
-        gap = float(np.hypot(*(np.asarray(start) - _piece_ends(out[0])[0])))
+        gap = float(np.hypot(*(np.asarray(start) - piece_ends(out[0])[0])))
         if floor < gap <= limit:
             out[0] = _with_start(out[0], np.asarray(start, dtype=float))
             moves.append(gap)
     if end is not None:
-        gap = float(np.hypot(*(np.asarray(end) - _piece_ends(out[-1])[1])))
+        gap = float(np.hypot(*(np.asarray(end) - piece_ends(out[-1])[1])))
         if floor < gap <= limit:
-            out[-1] = _reversed(_with_start(_reversed(out[-1]), np.asarray(end, dtype=float)))
+            turned = _with_start(reversed_piece(out[-1]), np.asarray(end, dtype=float))
+            out[-1] = reversed_piece(turned)
             moves.append(gap)
     return out, moves
 
@@ -259,7 +259,8 @@ def vertex_note(li: int, moved: list) -> str:
             f"the next curve in the CAD file (up to {max(moved):.3g} off it)")
 
 
-def _piece_ends(piece):
+def piece_ends(piece):
+    """(start, end) of a line, an arc or a (start, middle, end) point triple."""
     if isinstance(piece, tuple):
         return np.asarray(piece[0], dtype=float), np.asarray(piece[-1], dtype=float)
     return piece.p0, piece.p1
@@ -275,5 +276,6 @@ def _with_start(piece, p0):
     return piece.with_start(p0)
 
 
-def _reversed(piece):
+def reversed_piece(piece):
+    """The piece run the other way (a point triple, reversed)."""
     return tuple(piece[::-1]) if isinstance(piece, tuple) else piece.reversed()

@@ -24,7 +24,7 @@ from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
 from .free_faces import free_face_fills
 from .improve import BoundarySlide, improve_worst, polish_worst, sj_batch, strip_slides
-from .orientation import counter_clockwise_quads, signed_areas
+from .orientation import signed_areas
 
 SMOOTH_ITERATIONS = 40
 SMOOTH_FLOOR = 0.3
@@ -250,13 +250,12 @@ def _turned_by_block(nodes, quads, owner) -> np.ndarray:
     size: thin strips along its sides, where a hole's arc bulged the middle row of the
     map out of the strip, folded and given up: 64 % of it in blocks, worst 0.06; all in
     blocks and 0.86 since).  A free face's quads are turned one by one (gmsh's)."""
-    out = counter_clockwise_quads(nodes, quads)
+    area = signed_areas(nodes, quads)
     mapped = owner >= 0
+    clockwise = area < 0
     if mapped.any():
-        area = signed_areas(nodes, quads[mapped])
-        clockwise = np.bincount(owner[mapped], weights=area)[owner[mapped]] < 0
-        out[mapped] = np.where(clockwise[:, None], quads[mapped][:, ::-1], quads[mapped])
-    return out
+        clockwise[mapped] = np.bincount(owner[mapped], weights=area[mapped])[owner[mapped]] < 0
+    return np.where(clockwise[:, None], quads[:, ::-1], quads)
 
 
 def _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions) -> None:
