@@ -22,12 +22,11 @@ PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json")
 # (see SOURCES.md): joined at those vertices, as the CAD kernel has them.
 OFF_THEIR_VERTICES = {"ventilator_hub"}
 # Partly in blocks: some faces of the partition get unstructured quads (free faces).
-PARTLY_BLOCKS = {"blend_sawtooth", "blend_scallop_slots"}
-# No blocks at all at the default size: the free face by nist_ctc02_logo_plate's logo
-# (strokes a fraction of an element wide) cannot be filled, and the rebuilds dissolve
-# the lines round it round after round until none is left; gmsh's quads stand in.
-FALLS_BACK = {"nist_ctc02_logo_plate"}
-NO_BLOCKS_YET = PARTLY_BLOCKS | FALLS_BACK
+# nist_ctc02_logo_plate: the free face round its engraved logo (strokes a fraction of
+# an element wide) is filled with its boundary segments split (quadmesh.py), where the
+# rebuilds dissolved every line and gmsh's quads stood in for the whole face.
+PARTLY_BLOCKS = {"blend_sawtooth", "blend_scallop_slots", "nist_ctc02_logo_plate"}
+NO_BLOCKS_YET = PARTLY_BLOCKS
 MESHABLE = list(PARTS)
 
 
@@ -107,7 +106,7 @@ KNOWN_EXTRA_IRREGULAR = {"tailwheel_gusset": 1, "crank_arm_web": 2, "sketch_keyh
                          "blend_slotted_plate": 4, "perforated_plate": 29}
 
 
-@pytest.mark.parametrize("name", [n for n in MESHABLE if n not in NO_BLOCKS_YET])
+@pytest.mark.parametrize("name", [n for n in MESHABLE if n not in PARTLY_BLOCKS])
 def test_the_irregular_vertices_are_the_fields_own(name):
     # Tighter than the bound above (four to spare), which let grabcad_misc_part1 go from
     # 8 to 12 (a line read as arriving along the wrong separatrix of a window corner).
@@ -147,16 +146,19 @@ def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
         len(result.reference.field.singularities) + result.feature_corners + 4
 
 
-@pytest.mark.parametrize("name", sorted(FALLS_BACK))
-def test_a_corpus_face_that_falls_back_says_so_and_is_valid(name):
-    result = meshed(name)
+def test_the_logo_plate_falls_back_as_a_whole_without_finer_fills(monkeypatch):
+    # What the finer fills rescue: without them every line round the logo is dissolved.
+    from quadcnn_wb.core import pipeline
+
+    monkeypatch.setattr(pipeline, "_with_finer_fills", lambda *args: None)
+    monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
+    result = mesh_domain(load_domain(CORPUS / PARTS["nist_ctc02_logo_plate"]["file"]))
     assert not result.structured and "stand in" in result.problem
-    assert result.quality["min_scaled_jacobian"] > 0
-    assert result.to_json()["structured_share"] == 0.0
+    assert result.structured_share == 0.0
 
 
 def test_a_face_without_blocks_says_so(monkeypatch):
-    # Beside the faces in FALLS_BACK; with no rebuild allowed, the free
+    # No corpus face falls back as a whole any more; with no rebuild allowed, the free
     # faces of blend_scallop_slots that cannot be filled on the 2048-node background (and
     # no finer one allowed) leave no block partition, and the quads that stand in (gmsh's,
     # or the whole face as one free face where those fold) must say so everywhere.
@@ -174,8 +176,7 @@ def test_a_face_without_blocks_says_so(monkeypatch):
     assert data["problem"] == result.problem
 
 
-@pytest.mark.parametrize("name", [expected_failure(n, FALLS_BACK, "falls back as a whole")
-                                  for n in sorted(NO_BLOCKS_YET)])
+@pytest.mark.parametrize("name", sorted(PARTLY_BLOCKS))
 def test_faces_that_are_no_blocks_cost_only_themselves(name):
     result = meshed(name)
     assert 0.0 < result.structured_share < 1.0, result.problem

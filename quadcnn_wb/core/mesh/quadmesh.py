@@ -143,7 +143,11 @@ def _polyline_points(points: np.ndarray, n: int) -> np.ndarray:
     return points[k] + f[:, None] * (points[k + 1] - points[k])
 
 
-def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True) -> QuadMesh:
+def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True,
+                    finer_fills: bool = False) -> QuadMesh:
+    """The quad mesh of a partition and its segment counts; FreeFaceError where a free
+    face cannot be filled.  ``finer_fills``: such a face is tried again with its boundary
+    segments split (_finer_free_face) before it counts as unfillable."""
     layout = node_layout(partition, counts)
     found = merges(partition, layout, counts)
     if conflicts(layout, found):
@@ -203,7 +207,13 @@ def build_quad_mesh(domain, partition: Partition, counts, smoothing: bool = True
         failed, origins = [], set()  # every face that cannot be filled, so one rebuild
         for f, face in enumerate(partition.free_faces):  # can merge them all
             try:
-                q = _free_face(layout, ids, positions, face, pose)
+                try:
+                    q = _free_face(layout, ids, positions, face, pose)
+                except PartitionError:
+                    if not finer_fills:
+                        raise
+                    q = _finer_free_face(domain, partition, layout, ids, positions, face,
+                                         pose, where, boundary_ids)
             except PartitionError as exc:
                 failed.append(str(exc))
                 origins |= {partition.edges[e].origin for ring in face.rings for e, _ in ring
@@ -297,6 +307,65 @@ def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
             part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
             ring.extend(int(i) for i in ids[part[:-1]])
         rings.append(np.array(ring, dtype=np.int64))
+    return _filled(rings, positions, face, pose)
+
+
+FINER_SIDES = (3, 9)  # a free face's boundary segments split in this many, in turn
+
+
+def _finer_free_face(domain, partition, layout, ids, positions, face, pose, where,
+                     boundary_ids) -> np.ndarray:
+    """_free_face with the segments of its boundary edges split in FINER_SIDES parts on
+    the exact curves, where the side nodes the counts gave cannot be filled: a boundary
+    edge belongs to this face alone, so its extra nodes keep the mesh conforming, and
+    gmsh then follows detail far below the element size (an engraved logo's strokes,
+    whose chords crossed: the rebuilds dissolved every line round the logo, and gmsh's
+    quads stood in for the whole face).  Splits in an odd number of parts keep every
+    ring's node count even."""
+    for parts in FINER_SIDES:
+        before = len(positions)
+        rings, added = [], []
+        for ring_halves in face.rings:
+            ring = []
+            for e, forward in ring_halves:
+                part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
+                nodes = [int(i) for i in ids[part]]
+                extra = _split_points(domain, partition.edges[e], where[e], parts, forward)
+                for k in range(len(nodes) - 1):
+                    ring.append(nodes[k])
+                    for point in extra[k] if extra is not None else ():
+                        added.append(len(positions))
+                        ring.append(len(positions))
+                        positions.append(point)
+            rings.append(np.array(ring, dtype=np.int64))
+        if not added:
+            break
+        try:
+            quads = _filled(rings, positions, face, pose)
+        except PartitionError:
+            del positions[before:]
+            continue
+        boundary_ids.update(added)
+        return quads
+    raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
+                         "curved sides")
+
+
+def _split_points(domain, edge, spots, parts: int, forward: bool):
+    """Per segment of a boundary edge (in the walking direction), the parts - 1 points
+    that split it evenly along the exact curve; None for a streamline edge."""
+    if spots is None:
+        return None
+    chain = _EdgeChain(domain, edge)
+    along = np.array([chain.arc_length(i, t) for i, t in spots])
+    if not forward:
+        along = along[::-1]
+    steps = np.arange(1, parts) / parts
+    return [chain.point(a + steps * (b - a)) for a, b in zip(along[:-1], along[1:])]
+
+
+def _filled(rings, positions, face, pose) -> np.ndarray:
+    """gmsh's quads for the face bounded by ``rings`` (node ids); see _free_face."""
     every = np.concatenate(rings)
     if len(np.unique(every)) != len(every):
         raise PartitionError(f"a free face ({face.reason}) touches itself: no polygon to fill")
