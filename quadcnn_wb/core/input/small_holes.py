@@ -73,23 +73,38 @@ def field_direction(domain, hole: int, centre) -> float:
     where they cancel (a hole at the middle of a symmetric part, which any turn of the
     square fits as well), the direction of the part's canonical pose, so that a turned
     or mirrored copy turns its square alike rather than as round-off has it."""
+    loops, points, lengths, turns = _boundary_samples(domain)
+    others = loops != hole
+    distance = np.hypot(*np.moveaxis(points[others] - centre, -1, 0))
+    weight = lengths[others, None] / SAMPLES / np.maximum(distance, 1e-300) ** 4
+    # Summed curve by curve, in the loops' order, as a loop over the curves would.
     total, weights = 0j, 0.0
-    t = (np.arange(SAMPLES) + 0.5) / SAMPLES
-    for li, loop in enumerate(domain.loops):
-        if li == hole:
-            continue
-        for curve in loop:
-            points = np.atleast_2d(curve.point(t))
-            tangents = np.atleast_2d(curve.tangent(t))
-            distance = np.hypot(*(points - centre).T)
-            weight = curve.length / SAMPLES / np.maximum(distance, 1e-300) ** 4
-            alpha = np.arctan2(tangents[:, 1], tangents[:, 0])
-            total += np.sum(weight * np.exp(4j * alpha))
-            weights += float(np.sum(weight))
+    for turn, weight_sum in zip(np.sum(weight * turns[others], axis=1),
+                                np.sum(weight, axis=1)):
+        total += turn
+        weights += float(weight_sum)
     if abs(total) <= CANCELLED * weights:
         axis = canonical_pose(domain).matrix[0]
         return math.atan2(axis[1], axis[0])
     return float(np.angle(total) / 4.0)
+
+
+def _boundary_samples(domain) -> tuple:
+    """(loop of each curve, its SAMPLES points, its length, exp(4i tangent angle) at
+    them), sampled once per domain: every small hole of a part with hundreds of curves
+    asks (held-out 0095: 0.35 s a background, three times a run, when each sampled the
+    curves again)."""
+    cached = domain.__dict__.get("_field_samples")
+    if cached is None:
+        t = (np.arange(SAMPLES) + 0.5) / SAMPLES
+        curves = [(li, curve) for li, loop in enumerate(domain.loops) for curve in loop]
+        points = np.array([np.atleast_2d(curve.point(t)) for _, curve in curves])
+        tangents = np.array([np.atleast_2d(curve.tangent(t)) for _, curve in curves])
+        turns = np.exp(4j * np.arctan2(tangents[..., 1], tangents[..., 0]))
+        cached = (np.array([li for li, _ in curves]), points,
+                  np.array([curve.length for _, curve in curves]), turns)
+        domain.__dict__["_field_samples"] = cached
+    return cached
 
 
 def _quarters(circle: Arc, theta: float) -> tuple:
