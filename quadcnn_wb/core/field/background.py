@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 
 from ..gmsh_geometry import UNIT_DIGITS, build_geometry
 from ..gmsh_session import gmsh_session
-from ..input.corners import interior_angle, is_corner
+from ..input.corners import interior_angle, is_corner, odd_ties
 from ..input.curves import Arc
 from ..input.domain import Domain
 from ..input.features import JOINT_TOL, boundary_features, loop_offsets, mean_tangents
@@ -58,6 +58,9 @@ class BackgroundMesh:
     # (loop, segment, parameter, interior angle) of the corners features put inside a
     # curve (a small fillet's middle): vertices of the partition, as loop vertices are.
     feature_corners: frozenset = frozenset()
+    # Corner nodes of ties (odd multiples of 45°) that take the odd count of quarter
+    # turns (input.corners.odd_ties).
+    odd_tie_nodes: frozenset = frozenset()
 
     @property
     def n_nodes(self) -> int:
@@ -240,6 +243,7 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
     coords = np.array(coords, dtype=float)
     boundary, loops_of, segs_of, params, tangents = [], [], [], [], []
     corner_nodes, corner_angles, corner_in = [], [], []
+    ties, odd_nodes = odd_ties(domain), set()
     for li, loop in enumerate(domain.loops):
         for si, curve in enumerate(loop):
             ids = curve_nodes[(li, si)]
@@ -270,6 +274,8 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
                     corner_nodes.append(int(ids[0]))
                     corner_angles.append(angle)
                     corner_in.append(loop[si - 1].tangent(1.0))
+                    if (li, si) in ties:
+                        odd_nodes.add(int(ids[0]))
     triangles = _counter_clockwise(coords, np.asarray(triangles, dtype=np.int64))
     return BackgroundMesh(
         nodes=coords, triangles=triangles, boundary_nodes=np.array(boundary, dtype=np.int64),
@@ -280,7 +286,7 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
         corner_nodes=np.array(corner_nodes, dtype=np.int64),
         corner_angles=np.array(corner_angles, dtype=float),
         corner_tangents_in=np.array(corner_in, dtype=float).reshape(-1, 2),
-        element_size=float(h))
+        element_size=float(h), odd_tie_nodes=frozenset(odd_nodes))
 
 
 def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundMesh:

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from ..input.corners import at_quarter_tie, corner_quads, nearest_quarters
+from ..input.corners import at_quarter_tie, corner_quads, nearest_quarters, tie_quarters
 from .background import BackgroundMesh
 
 
@@ -117,7 +117,9 @@ def boundary_values(mesh: BackgroundMesh, sharp=None) -> np.ndarray:
         t_in = complex(*t_in)
         if at_quarter_tie(float(angle)):
             turn = np.angle(t[k] / t_in)  # the tangent's turn, signed as the loop runs
-            z[k] = t_in**4 * np.exp(2j * turn) * (-1) ** nearest_quarters(float(angle))
+            quarters = tie_quarters(float(angle)) if int(node) in mesh.odd_tie_nodes \
+                else nearest_quarters(float(angle))
+            z[k] = t_in**4 * np.exp(2j * turn) * (-1) ** quarters
         else:
             blend = t_in**4 + z[k]
             z[k] = blend / abs(blend)
@@ -361,7 +363,7 @@ def corner_sources(mesh: BackgroundMesh) -> tuple:
     out = []
     position = {int(n): k for k, n in enumerate(mesh.boundary_nodes)}
     for node, angle in zip(mesh.corner_nodes, mesh.corner_angles):
-        quarters = corner_quads(angle)
+        quarters = corner_quads(angle, int(node) in mesh.odd_tie_nodes)
         if quarters < 3:
             continue
         t_out = mesh.boundary_tangent[position[int(node)]]

@@ -270,24 +270,53 @@ def _turned_by_block(nodes, quads, owner) -> np.ndarray:
 
 def _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions) -> None:
     """Boundary nodes merged along boundary arcs with no segments (collapse.py): on the
-    corner among them if there is one, else half-way along the longest such arc (so that
-    the place does not hang on which end came first)."""
-    zero = sorted((e for e, edge in enumerate(partition.edges)
-                   if edge.is_boundary and int(counts[e]) == 0),
-                  key=lambda e: -partition.edges[e].length)
+    corner among them if there is one, else half-way along the run of those arcs, by arc
+    length (so that the place does not hang on which end came first, nor on which of two
+    arcs of one length round-off makes the longer: nist_ctc_01's face 116 has such pairs,
+    and a moved copy's node sat on the other arc's middle, a fifth of an element away,
+    where a free face beside it could no longer be filled)."""
+    zero = [e for e, edge in enumerate(partition.edges)
+            if edge.is_boundary and int(counts[e]) == 0]
     if not zero:
         return
     placed = set()
     for x in np.nonzero(layout.fixed & layout.boundary)[0]:
         positions[ids[x]] = raw[x]
         placed.add(int(ids[x]))
+    runs = {}
     for e in zero:
-        node = int(ids[partition.edges[e].a])
-        if node in placed:
-            continue
-        chain = _EdgeChain(domain, partition.edges[e])
-        positions[node] = chain.point(0.5 * float(chain.start[-1]))
-        placed.add(node)
+        runs.setdefault(int(ids[partition.edges[e].a]), []).append(e)
+    for node, run in runs.items():
+        if node not in placed:
+            positions[node] = _middle_of_run(domain, partition, run)
+
+
+def _middle_of_run(domain, partition, run) -> np.ndarray:
+    """The point half-way along boundary edges that join end to end (in any order and
+    direction); for edges that do not make one open path, the middle of the longest."""
+    ends = {}
+    for e in run:
+        for v in (partition.edges[e].a, partition.edges[e].b):
+            ends[v] = ends.get(v, 0) + 1
+    tips = sorted(v for v, n in ends.items() if n == 1)
+    chains = {e: _EdgeChain(domain, partition.edges[e]) for e in run}
+    if len(tips) != 2 or len(ends) != len(run) + 1:
+        longest = max(run, key=lambda e: (round(float(chains[e].start[-1]), 12), -e))
+        return chains[longest].point(0.5 * float(chains[longest].start[-1]))
+    walk, at, left = [], tips[0], set(run)
+    while left:
+        e = next(e for e in sorted(left) if at in (partition.edges[e].a, partition.edges[e].b))
+        forward = partition.edges[e].a == at
+        walk.append((e, forward))
+        at = partition.edges[e].b if forward else partition.edges[e].a
+        left.remove(e)
+    half = 0.5 * sum(float(chains[e].start[-1]) for e, _ in walk)
+    for k, (e, forward) in enumerate(walk):
+        length = float(chains[e].start[-1])
+        if half <= length or k == len(walk) - 1:
+            half = min(half, length)
+            return chains[e].point(half if forward else length - half)
+        half -= length
 
 
 class SquashedBlocks(PartitionError):
