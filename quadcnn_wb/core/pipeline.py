@@ -301,7 +301,6 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
                       problem=problem)
 
 
-
 def _with_finer_fills(domain, background, field, lines, size, smoothing, timings):
     """blocks_and_mesh again, its free faces that cannot be filled tried with their
     boundary segments split (quadmesh._finer_free_face) before their lines are

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from ..input.corners import at_quarter_tie, corner_quads, nearest_quarters, tie_quarters
+from ..input.corners import at_quarter_tie, corner_quads, corner_quarters
 from .background import BackgroundMesh
 
 
@@ -117,8 +117,7 @@ def boundary_values(mesh: BackgroundMesh, sharp=None) -> np.ndarray:
         t_in = complex(*t_in)
         if at_quarter_tie(float(angle)):
             turn = np.angle(t[k] / t_in)  # the tangent's turn, signed as the loop runs
-            quarters = tie_quarters(float(angle)) if int(node) in mesh.odd_tie_nodes \
-                else nearest_quarters(float(angle))
+            quarters = corner_quarters(float(angle), int(node) in mesh.odd_tie_nodes)
             z[k] = t_in**4 * np.exp(2j * turn) * (-1) ** quarters
         else:
             blend = t_in**4 + z[k]

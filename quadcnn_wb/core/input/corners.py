@@ -77,7 +77,12 @@ def at_quarter_tie(angle: float) -> bool:
 def corner_quads(angle: float, odd_tie: bool = False) -> int:
     """Quads a regular mesh puts at a corner of this interior angle (at least one);
     ``odd_tie``: a tie that takes its odd count (odd_ties)."""
-    return max(1, tie_quarters(angle) if odd_tie else nearest_quarters(angle))
+    return max(1, corner_quarters(angle, odd_tie))
+
+
+def corner_quarters(angle: float, odd_tie: bool = False) -> int:
+    """nearest_quarters, or a tie's odd count where ``odd_tie`` (odd_ties)."""
+    return tie_quarters(angle) if odd_tie else nearest_quarters(angle)
 
 
 def tie_quarters(angle: float) -> int:

@@ -13,6 +13,7 @@ value and SMOOTH_FLOOR; then the worst quads get max-min moves (improve.py).
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -294,10 +295,7 @@ def _place_slid_nodes(domain, partition, counts, layout, ids, raw, positions) ->
 def _middle_of_run(domain, partition, run) -> np.ndarray:
     """The point half-way along boundary edges that join end to end (in any order and
     direction); for edges that do not make one open path, the middle of the longest."""
-    ends = {}
-    for e in run:
-        for v in (partition.edges[e].a, partition.edges[e].b):
-            ends[v] = ends.get(v, 0) + 1
+    ends = Counter(v for e in run for v in (partition.edges[e].a, partition.edges[e].b))
     tips = sorted(v for v, n in ends.items() if n == 1)
     chains = {e: _EdgeChain(domain, partition.edges[e]) for e in run}
     if len(tips) != 2 or len(ends) != len(run) + 1:
@@ -329,14 +327,26 @@ class SquashedBlocks(PartitionError):
 
 def _free_face(layout, ids, positions, face, pose) -> np.ndarray:
     """Quads of one free face (global node ids); its interior points join positions."""
+    return _filled(_face_rings(layout, ids, face), positions, face, pose)
+
+
+def _face_rings(layout, ids, face, between=None) -> list:
+    """Node ids round each ring of a free face, its edges' nodes in walking order;
+    ``between(e, forward)``: per segment of edge e, the ids of extra nodes inside it
+    (None: none)."""
     rings = []
     for ring_halves in face.rings:
         ring = []
         for e, forward in ring_halves:
             part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
-            ring.extend(int(i) for i in ids[part[:-1]])
+            nodes = [int(i) for i in ids[part]]
+            extra = between(e, forward) if between is not None else None
+            for k in range(len(nodes) - 1):
+                ring.append(nodes[k])
+                if extra is not None:
+                    ring.extend(extra[k])
         rings.append(np.array(ring, dtype=np.int64))
-    return _filled(rings, positions, face, pose)
+    return rings
 
 
 FINER_SIDES = (3, 9)  # a free face's boundary segments split in this many, in turn
@@ -353,20 +363,9 @@ def _finer_free_face(domain, partition, layout, ids, positions, face, pose, wher
     ring's node count even."""
     for parts in FINER_SIDES:
         before = len(positions)
-        rings, added = [], []
-        for ring_halves in face.rings:
-            ring = []
-            for e, forward in ring_halves:
-                part = layout.edge_nodes[e] if forward else layout.edge_nodes[e][::-1]
-                nodes = [int(i) for i in ids[part]]
-                extra = _split_points(domain, partition.edges[e], where[e], parts, forward)
-                for k in range(len(nodes) - 1):
-                    ring.append(nodes[k])
-                    for point in extra[k] if extra is not None else ():
-                        added.append(len(positions))
-                        ring.append(len(positions))
-                        positions.append(point)
-            rings.append(np.array(ring, dtype=np.int64))
+        added = []
+        rings = _face_rings(layout, ids, face,
+                            _splitter(domain, partition, where, parts, positions, added))
         if not added:
             break
         try:
@@ -378,6 +377,23 @@ def _finer_free_face(domain, partition, layout, ids, positions, face, pose, wher
         return quads
     raise PartitionError(f"a free face ({face.reason}) gets inverted quads on its "
                          "curved sides")
+
+
+def _splitter(domain, partition, where, parts: int, positions: list, added: list):
+    """_face_rings' ``between`` for _finer_free_face: each boundary segment's split
+    points join ``positions`` (their ids also ``added``)."""
+    def between(e, forward):
+        extra = _split_points(domain, partition.edges[e], where[e], parts, forward)
+        if extra is None:
+            return None
+        ids_of = []
+        for points in extra:
+            ids_of.append(list(range(len(positions), len(positions) + len(points))))
+            positions.extend(points)
+            added.extend(ids_of[-1])
+        return ids_of
+
+    return between
 
 
 def _split_points(domain, edge, spots, parts: int, forward: bool):
