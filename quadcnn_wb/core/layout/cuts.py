@@ -59,31 +59,43 @@ def _cut_from(domain, mesh, field, li, walker):
 
 
 def fold_cuts(domain, mesh, field, places, existing) -> list:
-    """Field lines straight across the domain from the boundary node nearest each of
-    ``places`` (where a block's map folds), normal to the boundary there, that end on
-    the boundary.
+    """Field lines straight across the domain from the boundary node (not a corner)
+    nearest each of ``places`` (where a block's map folds), normal to the boundary
+    there, that end on the boundary.
 
     A long block that bends (a band round a letter S) has its sides' nodes spread
     evenly along each side; round a bend the inner side is shorter, so the grid lines
     slant more and more along the band until they cross.  A line across the band at
     the fold splits its sides, each part spread on its own.  A line from boundary to
     boundary adds no irregular vertex: it meets the boundary in a T, other lines in a
-    cross.  None from within two elements of an existing cut (two lines side by side
-    would leave a strip between them), and none shorter than an element (a line
-    across a corner's tip, no band's width: held-out 0061 got a worse mesh by one)."""
-    reach = 2.0 * mesh.element_size
-    tree = cKDTree(mesh.nodes[mesh.boundary_nodes])
-    out = []
-    for xy in places:
-        _, index = tree.query(xy)
-        node_xy = mesh.nodes[mesh.boundary_nodes[index]]
-        if any(np.hypot(*(c.points - node_xy).T).min() < reach for c in existing + out):
-            continue
-        cut = _cut_at(domain, mesh, field, int(index), mesh.walker)
+    cross.  None from within SPACING elements of another (two lines side by side would
+    leave a strip between them), and none shorter than MIN_CUT elements (a line across
+    a corner's tip, no band's width: held-out 0061 got a worse mesh by one)."""
+    h = mesh.element_size
+    # Not from a corner, whose tangent is either curve's (a mirrored copy, its loop run
+    # the other way, took the other curve's and another line: held-out 40mm_capot f179).
+    smooth = np.flatnonzero(~np.isin(mesh.boundary_nodes, mesh.corner_nodes))
+    tree = cKDTree(mesh.nodes[mesh.boundary_nodes[smooth]])
+    starts = sorted({int(smooth[tree.query(xy)[1]]) for xy in places})
+    candidates = []
+    for index in starts:
+        cut = _cut_at(domain, mesh, field, index, mesh.walker)
         length = float(np.hypot(*np.diff(cut.points, axis=0).T).sum())
-        if cut.end.kind == "boundary" and length >= mesh.element_size:
+        if cut.end.kind == "boundary" and length >= MIN_CUT * h:
+            candidates.append((length, cut))
+    # The longest first (a line across a whole band before a shorter one beside it), not
+    # in the places' order, which a mirrored copy's blocks come in otherwise.
+    candidates.sort(key=lambda pair: -pair[0])
+    out = []
+    for _, cut in candidates:
+        if all(np.hypot(*(c.points - cut.points[0]).T).min() >= SPACING * h
+               for c in existing + out):
             out.append(cut)
     return out
+
+
+MIN_CUT = 1.5  # elements: a shorter line crosses no band, only a corner's tip
+SPACING = 2.0  # elements: no line starts this near another
 
 
 def _cut_at(domain, mesh, field, index, walker):
