@@ -156,8 +156,9 @@ def test_faces_that_are_not_blocks_get_conforming_unstructured_quads():
     # makes these faces blocks round a centre): the free faces' own quads are tested here.
     cuts = connecting_cuts(result.domain, ref.mesh, ref.field, incomplete)
     timings = {"partition": 0.0, "quantization": 0.0, "quad_mesh": 0.0}
-    state = {"dissolve": frozenset(), "freed": set(), "unbalanced": set()}
-    _, partition, counts, mesh = _rounds(result.domain, ref.mesh, incomplete, cuts,
+    state = {"dissolve": frozenset(), "freed": set(), "unbalanced": set(), "cuts": cuts,
+             "fold_cuts": None}
+    _, partition, counts, mesh = _rounds(result.domain, ref.mesh, incomplete,
                                          result.size, True, timings, True,
                                          MIN_VALID_JACOBIAN, False, False, state)
     free = mesh.block_of_quad < 0
