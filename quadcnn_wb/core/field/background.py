@@ -117,10 +117,7 @@ class SizeSearch:
 
     The count falls with the size but in steps (a thin strip gains a whole row at once),
     so a plain proportional update can jump over the target forever; keeping the sizes
-    known to give too many and too few nodes makes each step land between them.  A
-    bracket narrower than STEP_RESOLUTION that the target still falls in is such a step
-    itself (sketch_slot_plate: 2485 nodes at one size, 1644 at a size 0.005 % larger,
-    and seven meshes more to find that out), which no finer search resolves.
+    known to give too many and too few nodes makes each step land between them.
     """
 
     def __init__(self, target: int, h: float):
@@ -140,7 +137,7 @@ class SizeSearch:
             self.too_coarse = (self.h, count)
         if self.too_fine and self.too_coarse:
             (h0, n0), (h1, n1) = self.too_fine, self.too_coarse
-            if h1 / h0 < 1.0 + STEP_RESOLUTION or n0 == n1:
+            if h1 / h0 < 1.0 + 1e-6 or n0 == n1:
                 return False
             slope = math.log(n1 / n0) / math.log(h1 / h0)
             guess = math.exp(math.log(h0) + math.log(self.target / n0) / slope)
@@ -152,7 +149,6 @@ class SizeSearch:
         return True
 
 
-STEP_RESOLUTION = 0.01  # a bracket of sizes this much apart is not narrowed further
 LOOSE_TOLERANCE = 0.5  # what the mesher accepts when the exact count cannot be had
 
 
