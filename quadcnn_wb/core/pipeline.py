@@ -20,6 +20,7 @@ from .input.domain import Domain
 from .input.features import boundary_features
 from .input.pose import default_size
 from .input.small_holes import squared_holes
+from .layout.components import Components
 from .layout.cusps import tip_corners, with_cusp_kites
 from .layout.cuts import connecting_cuts, fold_cuts
 from .layout.lenses import without_short_lenses
@@ -374,10 +375,9 @@ def blocks_and_mesh(domain, background, field, lines, size, smoothing, timings,
     0016 at diameter/100 a worst element of 0.29 for 0.88).  Not when ``allow_free`` is
     False (the cnn path: its lines are then not trusted).  ``worst_allowed``: the
     scaled Jacobian a mesh must beat (lower only where the alternative is a folded
-    mesh).  ``stop_at_free``: raise LeavesFreeFaces as soon
-    as the first partition has free faces.  ``finer_fills``: a free face that cannot be
-    filled is tried with its boundary segments split (quadmesh.build_quad_mesh) before
-    its lines are dissolved."""
+    mesh).  ``stop_at_free``: raise LeavesFreeFaces as soon as the first partition has
+    free faces.  ``finer_fills``: a free face that cannot be filled is tried with its
+    boundary segments split (quadmesh.build_quad_mesh) before its lines are dissolved."""
     spent = {"partition": 0.0, "quantization": 0.0, "quad_mesh": 0.0}
     cutter = FoldCutter(domain, background, field) if allow_free else None
     args = (domain, background, field, lines, size, smoothing, spent, allow_free,
@@ -408,8 +408,8 @@ GOOD_JACOBIAN = 0.5  # a mesh all in blocks and no worse than this is not raced
 
 
 def _whole_and_good(mesh) -> bool:
-    return structured_share(mesh) >= 1.0 and \
-        float(scaled_jacobians(mesh.nodes, mesh.quads).min()) >= GOOD_JACOBIAN
+    _, share, worst = _mesh_key(mesh)
+    return share >= 1.0 and worst >= GOOD_JACOBIAN
 
 
 def _blocks_and_mesh(domain, background, field, lines, size, smoothing, timings, allow_free,
@@ -651,24 +651,21 @@ class FoldCutter:
 
 
 def _fold_places(mesh, bad) -> list:
-    """The middle of each group of folded quads of a block (quads sharing a node), in
-    block order, then from the group's lowest quad."""
+    """The middle of each group of folded quads of a block (quads sharing a node)."""
     places = []
     for b in np.unique(mesh.block_of_quad[bad]):
         if b < 0:
             continue
         picked = np.flatnonzero(bad & (mesh.block_of_quad == b))
-        group = np.arange(len(picked))
-        for _ in range(len(picked)):  # label propagation over shared nodes
-            shares = (mesh.quads[picked][:, None, :, None]
-                      == mesh.quads[picked][None, :, None, :]).any(axis=(2, 3))
-            new = np.where(shares, group[None, :], len(picked)).min(axis=1)
-            if (new == group).all():
-                break
-            group = new
-        for g in np.unique(group):
-            quads = mesh.quads[picked[group == g]]
-            places.append(mesh.nodes[quads].reshape(-1, 2).mean(axis=0))
+        groups = Components()
+        for q in picked:
+            for n in mesh.quads[q]:
+                groups.union(("quad", int(q)), ("node", int(n)))
+        members: dict = {}  # root -> quads, in the order of each group's first quad
+        for q in picked:
+            members.setdefault(groups.find(("quad", int(q))), []).append(q)
+        for quads in members.values():
+            places.append(mesh.nodes[mesh.quads[quads]].reshape(-1, 2).mean(axis=0))
     return places
 
 
