@@ -175,3 +175,28 @@ def test_a_hole_with_no_corner_is_squared_only_below_an_element(length, squared)
     corners_read = [f for f in boundary_features(domain, SIZE)
                     if f.loop == 1 and f.angle == pytest.approx(1.5 * math.pi)]
     assert len(corners_read) == (4 if squared else 0)
+
+
+def test_holes_a_little_bigger_are_squared_where_round_ones_leave_free_faces(monkeypatch):
+    # NIST CTC 05's flange (tests/corpus) at a hundredth of its diameter: ten bolt holes
+    # of 3.4 sizes.  Read round, two of them close lenses between their rings of valence-5
+    # points; the layout with every hole under SQUARED_RESCUE sizes squared is all blocks.
+    from pathlib import Path
+
+    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core.input.load import load_domain
+    from quadcnn_wb.core.input.pose import diameter
+    from quadcnn_wb.core.input.small_holes import SQUARED_RESCUE
+
+    domain = load_domain(Path(__file__).parent / "corpus" / "nist_ctc05_flange.brep")
+    size = diameter(domain) / 100
+    bolt_holes = [2 * loop[0].radius / size for loop in domain.loops[2:]]
+    assert len(bolt_holes) == 10 and all(SMALL_HOLE < d < SQUARED_RESCUE for d in bolt_holes)
+    rescued = mesh_domain(domain, size=size)
+    assert rescued.structured_share == 1.0, rescued.problem
+    assert "other_holes" in rescued.timings  # the round layout was tried first, and lost
+    assert len(rescued.reference.field.singularities) < 40  # none round the bolt holes
+    monkeypatch.setattr(pipeline, "SQUARED_RESCUE", SMALL_HOLE)
+    round_only = mesh_domain(domain, size=size)
+    assert round_only.structured_share < 1.0
+    assert rescued.quality["min_scaled_jacobian"] > round_only.quality["min_scaled_jacobian"]
