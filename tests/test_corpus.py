@@ -235,6 +235,13 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # back.  The whole pipeline now runs in the part's frame (core.layout_frame).
 
 
+PART_POSES = ((37.0, False, 1.0, 0.0), (0.0, False, 1.0, 1e4), (211.0, True, 1.0, 0.0),
+              (131.0, False, 1e-3, 3.0))
+# The slowest parts (9 s and 5 s a mesh), in the poses that once gave them another mesh:
+# the suite's time, not the poses' worth, leaves out the others.
+SLOW_PART_POSES = {"nist_ctc01_logo_bracket": PART_POSES[1:3], "blend_sawtooth": PART_POSES[1:3]}
+
+
 @pytest.mark.parametrize("name", ["housing_rib", "io1_flange", "socket_bearing",
                                   "sketch_gasket", "sketch_bracket", "tailwheel_gusset",
                                   "sketch_keyhole_plate", "sketch_tslot_profile",
@@ -261,8 +268,7 @@ def test_a_part_gets_the_same_mesh_in_every_pose(name):
         return round(r.structured_share, 9), q["blocks"], q["quads"], q["irregular_vertices"]
 
     size = base.domain.size
-    for degrees, mirror, scale, shift in ((37.0, False, 1.0, 0.0), (0.0, False, 1.0, 1e4),
-                                          (211.0, True, 1.0, 0.0), (131.0, False, 1e-3, 3.0)):
+    for degrees, mirror, scale, shift in SLOW_PART_POSES.get(name, PART_POSES):
         moved = transform_domain_json(data, similarity(degrees, scale, mirror),
                                       np.full(2, shift * size * scale))
         assert signature(mesh_domain(domain_from_json(moved))) == signature(base), degrees

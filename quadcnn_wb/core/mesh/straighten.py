@@ -30,6 +30,7 @@ FOOT_REFINES = 3  # times the search narrows round the best sample
 KEEP_CLEAR = 0.25  # of its first spacing a slid node keeps from either neighbour
 GUARD = 0.8  # a round may lower no quad below this or the region's worst
 GUARD_TRIES = 10
+STILL = 1e-3  # of the median node spacing: a round that moves no node farther ends them
 # A mesh this bad somewhere is left as it is: a near-flat quad is a block folding (the
 # rounds free it or cut across it: pipeline.blocks_and_mesh), not one sheared by its
 # side nodes, and squaring the lines round it would hide it from them (blend_pocket_kink
@@ -62,24 +63,32 @@ def straightened(nodes, quads, fixed, slides: dict, owner) -> np.ndarray:
     if not len(sliding) and not free.any():
         return x
     neighbours, degree = _neighbours(region_quads, len(x))
-    started = np.array([slides[int(v)].t for v in sliding])
+    curves = [slides[int(v)].curve for v in sliding]
     by_curve: dict = {}
-    for k, v in enumerate(sliding):
-        by_curve.setdefault(id(slides[int(v)].curve), []).append(k)
+    for k, curve in enumerate(curves):
+        by_curve.setdefault(id(curve), []).append(k)
     groups = [np.array(members) for members in by_curve.values()]  # nodes on one curve
+    slots, fixed_t = _neighbour_slots(slides, sliding)
+    ts = np.array([slides[int(v)].t for v in sliding])
+
+    def bounds(ts):
+        ends = np.where(slots >= 0, ts[np.maximum(slots, 0)], fixed_t)
+        return ends.min(axis=1), ends.max(axis=1)
+
     # Each node keeps KEEP_CLEAR of its first spacing from either neighbour: the two
     # move at once, each at most RELAXATION of the way, so neither passes the other.
-    clear = np.array([KEEP_CLEAR * 0.5 * abs(np.subtract(*_bounds(slides[int(v)], slides)))
-                      for v in sliding])
-    ts = started.copy()
+    lo, hi = bounds(ts)
+    clear = KEEP_CLEAR * 0.5 * (hi - lo)
+    still = STILL * float(np.median(hi - lo)) if len(ts) else 0.0
     y = x.copy()
     quality = sj_batch(y[region_quads])
     for _ in range(STRAIGHTEN_ROUNDS):
+        lo, hi = bounds(ts)
+        feet = _feet(curves, groups, ts, lo + clear, hi - clear, y[across])
+        proposed = ts + RELAXATION * (feet - ts)
         proposal = y.copy()
-        proposed = ts + RELAXATION * (_feet(slides, sliding, groups, y[across], clear) - ts)
         for members in groups:
-            proposal[sliding[members]] = slides[int(sliding[members[0]])].curve.point(
-                proposed[members])
+            proposal[sliding[members]] = curves[members[0]].point(proposed[members])
         means = np.zeros_like(y)
         np.add.at(means, neighbours[:, 0], proposal[neighbours[:, 1]])
         proposal[free] = means[free] / degree[free, None]
@@ -93,21 +102,43 @@ def straightened(nodes, quads, fixed, slides: dict, owner) -> np.ndarray:
                 break
             undo = np.unique(region_quads[bad].ravel())
             proposal[undo] = y[undo]
-            proposed[np.isin(sliding, undo)] = ts[np.isin(sliding, undo)]
+            back = np.isin(sliding, undo)
+            proposed[back] = ts[back]
         if bad.any():
             break
+        moved = float(np.hypot(*(proposal - y).T).max())
         y, ts, quality = proposal, proposed, new_quality
-        for k, v in enumerate(sliding):
-            slides[int(v)].t = float(ts[k])
+        if moved <= still:
+            break
     before = sj[region].min()
-    after = sj_batch(y[region_quads]).min()
+    after = quality.min()
     # Positive corners do not exclude a quad slid over another (orientation.tiles_exactly).
     if not round(float(after), 9) > round(float(before), 9) or \
             (not tiles_exactly(y, region_quads) and tiles_exactly(x, region_quads)):
-        for v, t in zip(sliding, started):
-            slides[int(v)].t = t
         return x
+    for k, v in enumerate(sliding):
+        slides[int(v)].t = float(ts[k])
     return y
+
+
+def _neighbour_slots(slides, sliding):
+    """Per sliding node, its two neighbours along the boundary: their index among the
+    sliding nodes (-1: none) and, where they do not slide here, the arc length that
+    bounds it (a neighbour's that stays, or its stretch's end)."""
+    index = {int(v): k for k, v in enumerate(sliding)}
+    slots = np.full((len(sliding), 2), -1, dtype=np.int64)
+    fixed_t = np.zeros((len(sliding), 2))
+    for k, v in enumerate(sliding):
+        slide = slides[int(v)]
+        for side, (node, end) in enumerate(((slide.before, slide.t_before),
+                                            (slide.after, slide.t_after))):
+            if node is None:
+                fixed_t[k, side] = end
+            elif node in index:
+                slots[k, side] = index[node]
+            else:
+                fixed_t[k, side] = slides[node].t
+    return slots, fixed_t
 
 
 def _neighbours(quads, n: int):
@@ -147,33 +178,24 @@ def _edge_ends(quad, v: int) -> tuple:
     return int(quad[(c + 1) % 4]), int(quad[(c - 1) % 4])
 
 
-def _feet(slides, sliding, groups, targets, clear) -> np.ndarray:
-    """Per sliding node, the arc length between its neighbours, ``clear`` from either,
-    whose point is nearest its target: a grid search narrowed round the best sample,
+def _feet(curves, groups, ts, lo, hi, targets) -> np.ndarray:
+    """Per sliding node, the arc length in [lo, hi] whose point is nearest its target
+    (where lo < hi; else where it is): a grid search narrowed round the best sample,
     for all the nodes on one curve at once."""
-    out = np.array([slides[int(v)].t for v in sliding])
+    out = ts.copy()
+    steps = np.linspace(0.0, 1.0, FOOT_SAMPLES)
     for members in groups:
-        curve = slides[int(sliding[members[0]])].curve
-        bounds = np.array([_bounds(slides[int(sliding[k])], slides) for k in members])
-        lo, hi = bounds.min(axis=1) + clear[members], bounds.max(axis=1) - clear[members]
-        open_ = lo < hi
-        members, lo, hi = members[open_], lo[open_], hi[open_]
+        a, b = lo[members], hi[members]
+        open_ = a < b
+        members, a, b = members[open_], a[open_], b[open_]
         if not len(members):
             continue
-        steps = np.linspace(0.0, 1.0, FOOT_SAMPLES)
         for _ in range(FOOT_REFINES + 1):
-            grid = lo[:, None] + (hi - lo)[:, None] * steps[None, :]
-            points = curve.point(grid.ravel()).reshape(len(members), FOOT_SAMPLES, 2)
+            grid = a[:, None] + (b - a)[:, None] * steps[None, :]
+            points = curves[members[0]].point(grid.ravel()).reshape(len(members), -1, 2)
             d = np.hypot(*np.moveaxis(points - targets[members][:, None, :], -1, 0))
-            j = np.argmin(np.round(d, 12), axis=1)
-            best = grid[np.arange(len(members)), j]
-            step = (hi - lo) / (FOOT_SAMPLES - 1)
-            lo, hi = np.maximum(lo, best - step), np.minimum(hi, best + step)
+            best = grid[np.arange(len(members)), np.argmin(np.round(d, 12), axis=1)]
+            step = (b - a) / (FOOT_SAMPLES - 1)
+            a, b = np.maximum(a, best - step), np.minimum(b, best + step)
         out[members] = best
     return out
-
-
-def _bounds(slide, slides) -> tuple:
-    lo = slides[slide.before].t if slide.before is not None else slide.t_before
-    hi = slides[slide.after].t if slide.after is not None else slide.t_after
-    return lo, hi
