@@ -30,9 +30,7 @@ def tiles_exactly(nodes, quads) -> bool:
 
     Positive corners alone do not exclude a block folded over its neighbour; this does.
     """
-    p = nodes[quads]
-    area = 0.5 * np.sum(p[..., 0] * np.roll(p[..., 1], -1, axis=1)
-                        - np.roll(p[..., 0], -1, axis=1) * p[..., 1])
+    area = float(signed_areas(nodes, quads).sum())
     directed = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
     key = np.sort(directed, axis=1)
     _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)

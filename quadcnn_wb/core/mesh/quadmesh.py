@@ -23,6 +23,7 @@ from ..input.features import is_smooth_join
 from ..input.pose import canonical_pose
 from ..layout.collapse import conflicts, merges, node_layout, side_nodes
 from ..layout.partition_types import FreeFaceError, Partition, PartitionError
+from .edge_graph import edge_graph, neighbour_means
 from .free_faces import free_face_fills
 from .improve import BoundarySlide, improve_worst, polish_worst, sj_batch, strip_slides
 from .orientation import signed_areas
@@ -487,28 +488,12 @@ def _untangled(points, local, n_ring) -> np.ndarray:
 
 def _laplacian(points, quads, fixed, iterations) -> np.ndarray:
     """Plain (unguarded) Laplacian moves of the nodes not fixed."""
-    edges, degree = _edge_graph(quads, len(points))
+    edges, degree = edge_graph(quads, len(points))
     free = ~fixed & (degree > 0)
     x = points.copy()
     for _ in range(iterations):
-        x[free] = _neighbour_means(x, edges, degree)[free]
+        x[free] = neighbour_means(x, edges, degree)[free]
     return x
-
-
-def _edge_graph(quads, n: int) -> tuple:
-    """(unique quad edges (E, 2), number of edges at each of the n nodes)."""
-    edges = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    return edges, np.bincount(edges.ravel(), minlength=n).astype(float)
-
-
-def _neighbour_means(x, edges, degree) -> np.ndarray:
-    """Mean of each node's edge neighbours (rows of nodes on no edge are 0/0)."""
-    summed = np.zeros_like(x)
-    np.add.at(summed, edges[:, 0], x[edges[:, 1]])
-    np.add.at(summed, edges[:, 1], x[edges[:, 0]])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return summed / degree[:, None]
 
 
 def _coons(bottom, top, left, right) -> np.ndarray:
@@ -539,14 +524,14 @@ def smooth(nodes, quads, fixed, iterations: int = SMOOTH_ITERATIONS) -> np.ndarr
     """Guarded Laplacian smoothing of the free nodes."""
     if not len(quads):
         return nodes
-    edges, degree = _edge_graph(quads, len(nodes))
+    edges, degree = edge_graph(quads, len(nodes))
     free = ~fixed & (degree > 0)
     x = nodes.copy()
     span = float(np.ptp(x, axis=0).max())
     quality = scaled_jacobians(x, quads)
     for _ in range(iterations):
         proposal = x.copy()
-        proposal[free] = _neighbour_means(x, edges, degree)[free]
+        proposal[free] = neighbour_means(x, edges, degree)[free]
         new_quality = scaled_jacobians(proposal, quads)
         # The margin keeps rounding noise from deciding (a turned copy must decide alike).
         bad = new_quality < np.minimum(quality, SMOOTH_FLOOR) - 1e-12

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .edge_graph import edge_graph, neighbour_means
 from .improve import SLIDE_BELOW, sj_batch
 from .orientation import tiles_exactly
 
@@ -57,12 +58,12 @@ def straightened(nodes, quads, fixed, slides: dict, owner) -> np.ndarray:
     free = in_region & ~fixed & ~outside
     sliding = np.array(sorted(v for v in slides if in_region[v] and not outside[v]),
                        dtype=np.int64)
-    across = _across(region_quads, fixed, sliding, len(x))
+    across = _across(region_quads, sliding)
     keep = across >= 0
     sliding, across = sliding[keep], across[keep]
     if not len(sliding) and not free.any():
         return x
-    neighbours, degree = _neighbours(region_quads, len(x))
+    edges, degree = edge_graph(region_quads, len(x))
     curves = [slides[int(v)].curve for v in sliding]
     by_curve: dict = {}
     for k, curve in enumerate(curves):
@@ -89,9 +90,7 @@ def straightened(nodes, quads, fixed, slides: dict, owner) -> np.ndarray:
         proposal = y.copy()
         for members in groups:
             proposal[sliding[members]] = curves[members[0]].point(proposed[members])
-        means = np.zeros_like(y)
-        np.add.at(means, neighbours[:, 0], proposal[neighbours[:, 1]])
-        proposal[free] = means[free] / degree[free, None]
+        proposal[free] = neighbour_means(proposal, edges, degree)[free]
         # No quad may fall below the region's worst (or GUARD): the nodes of one that
         # would stay where they were this round.
         floor = min(GUARD, float(quality.min()))
@@ -141,17 +140,7 @@ def _neighbour_slots(slides, sliding):
     return slots, fixed_t
 
 
-def _neighbours(quads, n: int):
-    """(pairs (node, neighbour) of every quad edge both ways, each node's degree)."""
-    edges = np.concatenate([quads[:, [0, 1]], quads[:, [1, 2]], quads[:, [2, 3]],
-                            quads[:, [3, 0]]])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    pairs = np.concatenate([edges, edges[:, ::-1]])
-    degree = np.bincount(pairs[:, 0], minlength=n).astype(float)
-    return pairs, degree
-
-
-def _across(quads, fixed, sliding, n: int) -> np.ndarray:
+def _across(quads, sliding) -> np.ndarray:
     """For each sliding node, the node across its inward edge: the edge its two quads
     share (-1 where it has not exactly two quads, or they share no other node)."""
     out = np.full(len(sliding), -1, dtype=np.int64)

@@ -1,0 +1,22 @@
+"""A quad mesh's edges as a graph: what Laplacian smoothing (quadmesh.smooth) and the
+straightening's averaging (straighten.py) both read."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def edge_graph(quads, n: int) -> tuple:
+    """(unique quad edges (E, 2), number of edges at each of the n nodes)."""
+    edges = np.concatenate([quads[:, [k, (k + 1) % 4]] for k in range(4)])
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    return edges, np.bincount(edges.ravel(), minlength=n).astype(float)
+
+
+def neighbour_means(x, edges, degree) -> np.ndarray:
+    """Mean of each node's edge neighbours (rows of nodes on no edge are 0/0)."""
+    summed = np.zeros_like(x)
+    np.add.at(summed, edges[:, 0], x[edges[:, 1]])
+    np.add.at(summed, edges[:, 1], x[edges[:, 0]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return summed / degree[:, None]
