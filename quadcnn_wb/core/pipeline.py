@@ -280,11 +280,11 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
         clock = time.perf_counter()
         if method == "cnn":
             lines, _ = learned_streamlines(domain, background, field)
-            timings["reconstruction"] = time.perf_counter() - clock
         else:
             lines = trace_streamlines(domain, background, field)
-            timings["tracing"] = time.perf_counter() - clock
         lines = _t_mesh(domain, background, field, lines, size)
+        timings["reconstruction" if method == "cnn" else "tracing"] = \
+            time.perf_counter() - clock
     else:
         background, field, lines, timings = traced
         timings = dict(timings)
@@ -299,6 +299,8 @@ def _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamli
                 exc.traced = (background, field, lines,
                               {k: timings[k] for k in ("background", "field", "tracing")
                                if k in timings})
+                # The rounds' clock saw only its own stages.
+                exc.seconds += sum(exc.traced[3].values())
                 raise
         except PartitionError:
             if method != "cnn":
