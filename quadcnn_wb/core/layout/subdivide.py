@@ -82,7 +82,14 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
         elif len(corners) != 4 or reflex:
             odd.append((corners, sides, reflex))
     # Every side's middle first: a later face's split cuts an edge of an earlier face's
-    # side too, and that face's blocks must be made from its sides as finally cut.
+    # side too, and that face's blocks must be made from its sides as finally cut.  A
+    # side's middle may be a vertex an earlier face's split made, so the faces go in an
+    # order a turned, moved or mirrored copy shares (nist_ctc02_logo_plate at
+    # diameter/100: its mirror image split two touching faces the other way round, one
+    # middle moved by a tenth of an element, and the counts went another way): the
+    # largest first, whose middles the smaller ones beside them then share
+    # (nist_ctc04_plate at its default size is all blocks that way, not the other).
+    odd.sort(key=lambda face: _place_key(vertices, face[0]))
     holders = _sides_holding(everything)
     all_mids = [[None if _next_to_reflex(j, len(corners), reflex)
                  else _split_side(vertices, edges, holders, sides, j, domain)
@@ -148,6 +155,21 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
             blocks.append(Block(corners=tuple(face[0]),
                                 sides=tuple(tuple(s) for s in face[1])))
     return vertices, blocks, [FreeFace(tuple(h), reason) for h, reason in free_halves]
+
+
+def _place_key(vertices, corners) -> tuple:
+    """What every copy of the part sees alike in the layout frame (whose mirror image
+    negates x): the area of a face's corner polygon, largest first, then the mean of its
+    corners, y then |x|; rounded well above round-off."""
+    p = np.array([vertices[c] for c in corners], dtype=float)
+    area = 0.5 * abs(float(np.sum(p[:, 0] * np.roll(p[:, 1], -1)
+                                  - np.roll(p[:, 0], -1) * p[:, 1])))
+    x, y = p.mean(axis=0)
+    return (-round(area, PLACE_DIGITS), round(float(y), PLACE_DIGITS),
+            round(abs(float(x)), PLACE_DIGITS))
+
+
+PLACE_DIGITS = 9  # of the layout frame's unit coordinates
 
 
 def _next_to_reflex(j: int, k: int, reflex) -> bool:
