@@ -14,7 +14,9 @@ from pathlib import Path
 import pytest
 
 from quadcnn_wb.core.input.load import load_domain
-from quadcnn_wb.core.pipeline import free_edges_on_boundary, mesh_domain, tiles_exactly
+from quadcnn_wb.core.mesh.orientation import tiles_exactly
+from quadcnn_wb.core.mesh.validity import free_edges_on_boundary
+from quadcnn_wb.core.pipeline import mesh_domain
 
 CORPUS = Path(__file__).parent / "corpus"
 PARTS = {entry["name"]: entry for entry in json.loads((CORPUS / "manifest.json").read_text())}
@@ -155,11 +157,11 @@ def test_every_face_is_block_structured_at_a_hundredth_of_its_diameter(name):
 
 def test_the_logo_plate_falls_back_as_a_whole_without_finer_fills(monkeypatch):
     # What the finer fills rescue: without them every line round the logo is dissolved.
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
 
     # (Lines across folding blocks, layout.cuts.fold_cuts, make it all blocks now; without
     # them the finer fills are what is left.)
-    monkeypatch.setattr(pipeline, "FOLD_CUT_ROUNDS", 0)
+    monkeypatch.setattr(rounds, "FOLD_CUT_ROUNDS", 0)
     monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
     domain = load_domain(CORPUS / PARTS["nist_ctc02_logo_plate"]["file"])
     filled = mesh_domain(domain)
@@ -177,9 +179,9 @@ def test_a_face_without_blocks_says_so(monkeypatch):
     # or the whole face as one free face where those fold) must say so everywhere.
     # (nist_ctc04_plate did so until its small holes' corner lines left straight along
     # the squares' sides: then only one face of 190 was no block.)
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
 
-    monkeypatch.setattr(pipeline, "FREEING_ROUNDS", 0)
+    monkeypatch.setattr(rounds, "FREEING_ROUNDS", 0)
     monkeypatch.setattr(pipeline, "FINER_BACKGROUND", 1)
     result = mesh_domain(load_domain(CORPUS / PARTS["blend_scallop_slots"]["file"]))
     assert not result.structured and "no block structure" in result.problem
@@ -219,7 +221,7 @@ def test_faces_that_are_no_blocks_cost_only_themselves(name):
 # links in the pose's node order; blend_plate_hole: a separatrix ended on the singular
 # point it passes (field_rules: measured along the lines, alike in every pose);
 # blend_horn_plate: its horns' tips read 0° or 360° and their tip quads flat or not as
-# round-off had it in each pose (input.corners, pipeline.TIP_JACOBIAN); blend_sawtooth:
+# round-off had it in each pose (input.corners, rounds.TIP_JACOBIAN); blend_sawtooth:
 # the line moved off a wedge at a tooth's root was the first in the traces' order, which
 # a mirror image reverses (layout.wedges); blend_scallop_slots: a corner's trace of no
 # length took a separatrix's slot, flat fill quads read 0 or +-1e-17, tied smoothing
@@ -332,12 +334,12 @@ def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_so
     # nist_ctc04_plate's finer layouts are all blocks.  No
     # corpus part's finer layout is under GOOD_ENOUGH any more; asked for more than all
     # blocks, nist_ctc04_plate's first layout is finished too (from its own streamlines).
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
     from quadcnn_wb.core.input.pose import diameter
 
     if good_enough is not None:
         monkeypatch.setattr(pipeline, "GOOD_ENOUGH", good_enough[0])
-        monkeypatch.setattr(pipeline, "FAIR_JACOBIAN", good_enough[1])
+        monkeypatch.setattr(rounds, "FAIR_JACOBIAN", good_enough[1])
 
     calls, reused = [], []
     real = pipeline._mesh_on_background
@@ -371,7 +373,7 @@ def test_a_first_layout_with_free_faces_is_finished_only_if_the_finer_one_has_so
 
 def test_two_lines_round_a_thin_lens_become_one():
     # grabcad_part19's bosses: two traces meet on the same stretch and bound a lens half
-    # an element wide (pipeline._twin_lines); with one of them gone its 2048-node layout
+    # an element wide (rounds._twin_lines); with one of them gone its 2048-node layout
     # is all blocks, so the finer one is not tried (it had 56 irregular vertices).
     result = meshed("grabcad_part19")
     assert result.structured_share == 1.0 and "other_background" not in result.timings
@@ -453,19 +455,20 @@ def test_blocks_given_up_once_are_not_posed_to_the_program_again(monkeypatch):
     # a short boundary arc may have none (a trace that ended beside a corner); with every
     # boundary arc held to one segment, as before, two blocks are given up.
     from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import rounds as layout_rounds
     from quadcnn_wb.core.input.pose import diameter
     from quadcnn_wb.core.input.small_holes import squared_holes
     from quadcnn_wb.core.layout import quantize
 
     rounds = []
-    real = pipeline.quantize_freeing
+    real = layout_rounds.quantize_freeing
 
     def recorded(partition, size):
         counts, unequal = real(partition, size)
-        rounds.append({pipeline._block_key(partition, b) for b in unequal})
+        rounds.append({layout_rounds._block_key(partition, b) for b in unequal})
         return counts, unequal
 
-    monkeypatch.setattr(pipeline, "quantize_freeing", recorded)
+    monkeypatch.setattr(layout_rounds, "quantize_freeing", recorded)
     monkeypatch.setattr(quantize, "SHORT_BOUNDARY_ARC", -1.0)
     domain = load_domain(CORPUS / PARTS["grabcad_part19"]["file"])
     size = diameter(domain) / 40
@@ -485,19 +488,19 @@ def test_blocks_whose_counts_cannot_balance_are_found_as_the_exact_program_finds
     program then chooses among those and their neighbours only.  On grabcad_part19 (as
     in the test above) it gives up the very blocks the unrestricted program does, and
     every other block balances."""
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
     from quadcnn_wb.core.input.pose import diameter
     from quadcnn_wb.core.input.small_holes import squared_holes
     from quadcnn_wb.core.layout import quantize
 
     posed = []
-    real = pipeline.quantize_freeing
+    real = rounds.quantize_freeing
 
     def recorded(partition, size):
         posed.append((partition, size))
         return real(partition, size)
 
-    monkeypatch.setattr(pipeline, "quantize_freeing", recorded)
+    monkeypatch.setattr(rounds, "quantize_freeing", recorded)
     monkeypatch.setattr(quantize, "SHORT_BOUNDARY_ARC", -1.0)
     domain = load_domain(CORPUS / PARTS["grabcad_part19"]["file"])
     size = diameter(domain) / 40
@@ -517,7 +520,7 @@ def test_blocks_whose_counts_cannot_balance_are_found_as_the_exact_program_finds
 def _first_partition(name, nodes=2048):
     """The first partition the pipeline poses to the segment-count program for a corpus
     part at its default size, on ``nodes`` background nodes."""
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
     from quadcnn_wb.core.input.pose import default_size
     from quadcnn_wb.core.input.small_holes import squared_holes
 
@@ -533,7 +536,7 @@ def _first_partition(name, nodes=2048):
     domain = load_domain(CORPUS / PARTS[name]["file"])
     size = default_size(domain)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(pipeline, "quantize_freeing", record)
+        patch.setattr(rounds, "quantize_freeing", record)
         with pytest.raises(Posed):
             pipeline._mesh_on_background(squared_holes(domain, size), size, nodes,
                                          "numerical", True, None)
@@ -569,14 +572,14 @@ def test_a_first_layout_that_must_give_a_block_up_stops_before_choosing_which(mo
     the first layout leaves free faces; choosing which blocks to give up is the slow
     program, so it is not posed (nist_ctc04_plate at its default size: 2 s in all, 22.8 s
     when it was)."""
-    from quadcnn_wb.core import pipeline
+    from quadcnn_wb.core import pipeline, rounds
     from quadcnn_wb.core.input.pose import default_size
     from quadcnn_wb.core.input.small_holes import squared_holes
 
     def refuse(partition, size):
         raise AssertionError("the program that gives blocks up was posed")
 
-    monkeypatch.setattr(pipeline, "quantize_freeing", refuse)
+    monkeypatch.setattr(rounds, "quantize_freeing", refuse)
     domain = load_domain(CORPUS / PARTS["nist_ctc04_plate"]["file"])
     size = default_size(domain)
     with pytest.raises(pipeline.LeavesFreeFaces):

@@ -1,4 +1,4 @@
-"""Lines across blocks whose maps fold (layout.cuts.fold_cuts, pipeline.FoldCutter).
+"""Lines across blocks whose maps fold (layout.cuts.fold_cuts, rounds.FoldCutter).
 
 A band bent round small arcs (the raised letter S of NIST CTC 01's "LST",
 tests/corpus/nist_ctc01_letters) has no singular point inside to cut it: one block runs
@@ -15,11 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from quadcnn_wb.core import pipeline
+from quadcnn_wb.core import rounds
 from quadcnn_wb.core.field.reference import background_and_field
 from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.layout.cuts import fold_cuts
-from quadcnn_wb.core.pipeline import mesh_domain, tiles_exactly
+from quadcnn_wb.core.mesh.orientation import tiles_exactly
+from quadcnn_wb.core.pipeline import mesh_domain
 
 CORPUS = Path(__file__).parent / "corpus"
 LETTERS = CORPUS / "nist_ctc01_letters.brep"
@@ -50,7 +51,7 @@ def test_lines_across_the_folds_make_the_bent_band_blocks(letters):
 
 
 def test_without_them_the_band_is_freed(monkeypatch):
-    monkeypatch.setattr(pipeline, "FOLD_CUT_ROUNDS", 0)
+    monkeypatch.setattr(rounds, "FOLD_CUT_ROUNDS", 0)
     result = mesh_domain(load_domain(LETTERS))
     assert result.structured_share < 0.5
     assert "degenerate" in result.problem
@@ -80,7 +81,7 @@ def test_a_worse_mesh_with_the_lines_loses_to_the_one_without(monkeypatch):
     domain = load_domain(CORPUS / "blend_pocket_kink.brep")
     size = diameter(domain) / 100
     best = mesh_domain(domain, size=size)
-    monkeypatch.setattr(pipeline, "GOOD_JACOBIAN", -1.0)  # the lines' mesh, unraced
+    monkeypatch.setattr(rounds, "GOOD_JACOBIAN", -1.0)  # the lines' mesh, unraced
     raw = mesh_domain(domain, size=size)
     assert best.structured_share == 1.0
     assert best.quality["min_scaled_jacobian"] > raw.quality["min_scaled_jacobian"] + 0.2

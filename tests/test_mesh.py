@@ -137,12 +137,9 @@ def test_mesh_command_refuses_what_it_cannot_do(tmp_path):
 def test_faces_that_are_not_blocks_get_conforming_unstructured_quads():
     from quadcnn_wb.core.layout.cuts import connecting_cuts
     from quadcnn_wb.core.layout.partition import build_partition
-    from quadcnn_wb.core.pipeline import (
-        MIN_VALID_JACOBIAN,
-        _rounds,
-        free_edges_on_boundary,
-        tiles_exactly,
-    )
+    from quadcnn_wb.core.mesh.orientation import tiles_exactly
+    from quadcnn_wb.core.mesh.validity import free_edges_on_boundary
+    from quadcnn_wb.core.rounds import MIN_VALID_JACOBIAN, _rounds
 
     result = meshed("plate_hole")
     lines = list(result.reference.streamlines)
@@ -198,7 +195,7 @@ def test_three_cornered_faces_are_split_into_blocks():
 
 
 def test_overlapping_blocks_are_detected():
-    from quadcnn_wb.core.pipeline import tiles_exactly
+    from quadcnn_wb.core.mesh.orientation import tiles_exactly
 
     nodes = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]], dtype=float)
     side_by_side = np.array([[0, 1, 2, 3], [1, 4, 5, 2]])
@@ -365,7 +362,7 @@ def test_of_two_layouts_a_near_flat_quad_outweighs_a_higher_structured_share():
     """mesh_domain keeps the better of two backgrounds' meshes: more of it in blocks,
     then the better worst element, but one with a quad under FAIR_JACOBIAN loses."""
     from quadcnn_wb.core.mesh.quadmesh import QuadMesh
-    from quadcnn_wb.core.pipeline import FAIR_JACOBIAN, _mesh_key
+    from quadcnn_wb.core.rounds import FAIR_JACOBIAN, mesh_key
 
     def strip(top_shift, blocks):
         # Two quads side by side; shifting the top middle node skews both.
@@ -377,9 +374,9 @@ def test_of_two_layouts_a_near_flat_quad_outweighs_a_higher_structured_share():
     all_blocks_fine = strip(0.3, [0, 1])
     all_blocks_sliver = strip(4.0, [0, 1])
     half_blocks_fair = strip(0.5, [0, -1])
-    assert _mesh_key(all_blocks_sliver)[2] < FAIR_JACOBIAN < _mesh_key(half_blocks_fair)[2]
-    assert _mesh_key(half_blocks_fair) > _mesh_key(all_blocks_sliver)
-    assert _mesh_key(all_blocks_fine) > _mesh_key(half_blocks_fair)
+    assert mesh_key(all_blocks_sliver)[2] < FAIR_JACOBIAN < mesh_key(half_blocks_fair)[2]
+    assert mesh_key(half_blocks_fair) > mesh_key(all_blocks_sliver)
+    assert mesh_key(all_blocks_fine) > mesh_key(half_blocks_fair)
 
 
 def test_boundary_nodes_slide_across_smooth_joints_but_not_past_corners():

@@ -12,8 +12,9 @@ import pytest
 from quadcnn_wb.core.input.load import load_domain
 from quadcnn_wb.core.mesh import quadmesh
 from quadcnn_wb.core.mesh.improve import SLIDE_BELOW
+from quadcnn_wb.core.mesh.orientation import tiles_exactly
 from quadcnn_wb.core.mesh.quadmesh import scaled_jacobians
-from quadcnn_wb.core.pipeline import mesh_domain, tiles_exactly
+from quadcnn_wb.core.pipeline import mesh_domain
 
 LETTERS = Path(__file__).parent / "corpus" / "nist_ctc01_letters.brep"
 

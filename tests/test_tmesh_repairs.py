@@ -175,7 +175,7 @@ def test_boundary_edges_are_measured_along_their_curves():
 
 def test_the_share_of_the_area_in_blocks_is_what_the_free_faces_leave():
     # The hexagon cut in two: both blocks, one, none (free_blocks), and the share of the
-    # area in blocks that ranks a rebuild against the mesh in hand (pipeline._rounds).
+    # area in blocks that ranks a rebuild against the mesh in hand (rounds._rounds).
     domain = _elongated_hexagon()
     partition = build_partition(domain, [], 1.0, last_resort=True)
     assert block_area_share(partition, domain.area) == pytest.approx(1.0)

@@ -91,7 +91,7 @@ def build_partition(domain, streamlines, element_size: float, cuts=(),
     face becomes two blocks (subdivide.py) instead of a free face, and a face of up to
     STAR_CORNERS corners or with reflex corners (none next to another, none turning
     back by more than STAR_REFLEX) becomes blocks round a centre; the cut's ends and the
-    centres are irregular vertices, so that is the last resort (pipeline.blocks_and_mesh)."""
+    centres are irregular vertices, so that is the last resort (rounds.blocks_and_mesh)."""
     every = list(streamlines) + list(cuts)
     lines = [np.asarray(s.points, dtype=float) for s in every]
     ends = [(s.start, s.end) for s in every]
@@ -824,7 +824,7 @@ def _with_two_more_corners(turns, corner_at):
 
 
 def corners_instead_of_4(n: int) -> str:
-    """How a free face's reason names a face with n corners (pipeline.blocks_and_mesh
+    """How a free face's reason names a face with n corners (rounds.blocks_and_mesh
     looks for six)."""
     return f"has {n} corners instead of 4"
 

@@ -33,7 +33,7 @@ GUARD = 0.8  # a round may lower no quad below this or the region's worst
 GUARD_TRIES = 10
 STILL = 1e-3  # of the median node spacing: a round that moves no node farther ends them
 # A mesh this bad somewhere is left as it is: a near-flat quad is a block folding (the
-# rounds free it or cut across it: pipeline.blocks_and_mesh), not one sheared by its
+# rounds free it or cut across it: rounds.blocks_and_mesh), not one sheared by its
 # side nodes, and squaring the lines round it would hide it from them (blend_pocket_kink
 # at diameter/100: 0.154 straightened, kept, where the rounds give 0.878).
 FOLDED_BELOW = 0.2
