@@ -22,16 +22,21 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
     (parts / "open.json").write_text(json.dumps(
         {"loops": [[{"line": [[0, 0], [1, 0]]}, {"line": [[1, 0], [1, 1]]}]]}))
     (parts / "notes.txt").write_text("not a part")
+    (parts / "manifest.json").write_text(json.dumps({"l_shape": {"source": "bundled"}}))
+    (parts / "broken.json").write_text('{"loops": [')
     rows = tmp_path / "rows.jsonl"
     run = run_folder(parts, "--rows", rows, "--time-limit", 300)
     assert run.returncode == 0, run.stderr
+    assert "skipped (JSON of something else: no 'loops'): manifest.json" in run.stdout
     written = [json.loads(line) for line in rows.read_text().splitlines()]
     assert {(r["name"], r["size_kind"]) for r in written} == {
-        ("l_shape", "default"), ("l_shape", "d100"), ("open", "default"), ("open", "d100")}
+        ("l_shape", "default"), ("l_shape", "d100"), ("open", "default"), ("open", "d100"),
+        ("broken", "default"), ("broken", "d100")}
     good = [r for r in written if r["name"] == "l_shape"]
     assert all(r["structured_share"] == 1.0 and r["quads"] > 0 for r in good)
     assert all("open loop" in r["error"] for r in written if r["name"] == "open")
-    assert "default: all in blocks 1/2 (1 errors)" in run.stdout
+    assert all(r["error"] for r in written if r["name"] == "broken")  # a corrupt part
+    assert "default: all in blocks 1/3 (2 errors)" in run.stdout
 
     again = run_folder(parts, "--names", "l_shape", "--compare", rows)
     assert again.returncode == 0, again.stderr

@@ -5,7 +5,8 @@
                                           [--poses]
 
 For faces nobody here wrote (a user's own parts, a held-out set of public CAD files): each
-file (.brep .step .stp .iges .igs .json) and size runs in a fresh Python with a time limit,
+file (.brep .step .stp .iges .igs .json; JSON objects without "loops", such as a manifest
+or a mesh result, are skipped and named) and size runs in a fresh Python with a time limit,
 so a hang or a crash costs that row only.  One line is printed per row and one JSON line
 appended to ROWS (name, size_kind, structured_share, irregular_vertices,
 min_scaled_jacobian, quads, mesh_s, wall_s, or error; mesh_s is timed after one small part
@@ -185,6 +186,19 @@ def load_rows(path) -> dict:
     return rows
 
 
+def holds_a_part(path: Path) -> bool:
+    """False for a JSON file that is plainly something else (an object without "loops":
+    a folder's manifest, a mesh result the command line wrote); a file that does not
+    parse is a part, whose row then names what is wrong with it."""
+    if path.suffix.lower() != ".json":
+        return True
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return True
+    return not isinstance(data, dict) or "loops" in data
+
+
 def differs(a, b) -> bool:
     if a is None or b is None or ("error" in a) != ("error" in b):
         return True
@@ -258,6 +272,11 @@ def main(argv=None) -> int:
                              "and say whether every copy gets the same mesh")
     args = parser.parse_args(argv)
     files = sorted(p for p in args.folder.iterdir() if p.suffix.lower() in SUFFIXES)
+    others = [p for p in files if not holds_a_part(p)]
+    if others:
+        print(f"skipped (JSON of something else: no 'loops'): "
+              f"{', '.join(p.name for p in others)}", flush=True)
+    files = [p for p in files if p not in others]
     if args.names:
         files = [p for p in files if p.stem in set(args.names)]
     if not files:
