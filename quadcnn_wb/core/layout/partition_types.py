@@ -11,6 +11,7 @@ and how an error message names a point.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -64,8 +65,10 @@ class Edge:
     def is_boundary(self) -> bool:
         return bool(self.pieces)
 
-    @property
+    @cached_property
     def length(self) -> float:
+        """Asked of every edge many times per face walk; an edge's points never change
+        (a split or a renumbering makes a new Edge), so it is measured once."""
         if self.exact_length >= 0.0:
             return self.exact_length
         return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
