@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadcnn_wb.core.layout.face_geometry import segment_inside
 from quadcnn_wb.core.layout.partition_types import Edge
-from quadcnn_wb.core.layout.subdivide import _inside, split_odd_faces
+from quadcnn_wb.core.layout.subdivide import split_odd_faces
 
 
 def _bulging_pentagon():
@@ -31,7 +32,7 @@ def test_a_face_whose_side_bulges_in_gets_its_centre_where_every_spoke_stays_ins
     vertices, edges, sides = _bulging_pentagon()
     outline = np.vstack([edge.points[:-1] for edge in edges])
     naive = np.mean(vertices + [edge.points[len(edge.points) // 2] for edge in edges], axis=0)
-    assert not _inside(outline, naive, vertices[2])  # what the mean centre would do
+    assert not segment_inside(outline, naive, vertices[2])  # what the mean centre would do
     edges_out = list(edges)
     vertices_out, blocks, free = split_odd_faces(vertices, edges_out, [(list(range(5)),
                                                   sides, ())], [], None)
@@ -40,7 +41,7 @@ def test_a_face_whose_side_bulges_in_gets_its_centre_where_every_spoke_stays_ins
     spokes = [edge for edge in edges_out if edge.a == centre_id]
     assert len(spokes) == 5
     for spoke in spokes:
-        assert _inside(outline, spoke.points[0], spoke.points[-1])
+        assert segment_inside(outline, spoke.points[0], spoke.points[-1])
 
 
 def _two_triangles_on_one_line():

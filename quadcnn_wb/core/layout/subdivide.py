@@ -5,10 +5,12 @@ nearly coincide, a face of the streamline arrangement can come out with 3 or 5 c
 Midpoint subdivision turns a k-cornered face into k blocks meeting at its centre: every
 side is cut at its middle (the neighbouring block just gets a T-junction there) and joined
 to the centre.  The centre becomes one extra irregular vertex (valence k), which is the
-price of a block-structured mesh there.  A face too concave for that stays a free face
-(unstructured quads, see free_faces.py).  A six-cornered face (when the partition is
+price of a block-structured mesh there.  A six-cornered face (when the partition is
 asked for it: the last resort, see partition.build_partition) is instead cut straight
-between two opposite corners into two blocks, an extra edge at each end of the cut.
+between two opposite corners into two blocks, an extra edge at each end of the cut.  A
+five- or six-cornered face too concave for either is cut from corners to sides where
+such cuts stay inside it (peel.py); only what none of these splits stays a free face
+(unstructured quads, see free_faces.py).
 
 The last resort also splits round a centre what would otherwise stay free: a six-cornered
 face with no such cut, faces of up to eight corners, and faces with reflex corners (a
@@ -21,11 +23,10 @@ free).  Every spoke must then lie inside the face.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .crossings import cumulative_length, point_at
+from .face_geometry import ccw_angle, segment_inside, side_of
 from .partition_types import (
     Block,
     BoundaryPiece,
@@ -36,6 +37,7 @@ from .partition_types import (
     inside_polygon,
     pieces_length,
 )
+from .peel import peel_plan, pieces
 
 MIDPOINT_SNAP = 0.25  # use an existing side vertex this close to the middle (share of side)
 
@@ -62,7 +64,7 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
     # Six-cornered faces are cut between two opposite corners first (no centre, no new
     # side middles): their cut is decided on the sides as they are now, which the other
     # faces' splits only subdivide.
-    halved, odd = [], []
+    halved, odd, peeled = [], [], []
     for face in faces:
         corners, sides, reflex = face
         if len(corners) == 6 and not reflex:
@@ -72,6 +74,9 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
                 halved.append((corners, sides, at, key))
             elif star and key not in unsplit:
                 odd.append((corners, sides, reflex))
+            elif key not in unsplit and (plan := _peel_plan(vertices, edges, corners,
+                                                             sides)) is not None:
+                peeled.append((corners, sides, plan, key))
             else:
                 why = "whose split could not be filled" if key in unsplit \
                     else "has no cut into two quadrilaterals"
@@ -94,6 +99,10 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
     all_mids = [[None if _next_to_reflex(j, len(corners), reflex)
                  else _split_side(vertices, edges, holders, sides, j, domain)
                  for j in range(len(sides))] for corners, sides, reflex in odd]
+    # Where no centre sees a face's sides, straight cuts from corners to sides may still
+    # make it blocks (peel.py); their feet split sides too, so every such split comes
+    # before any block is made.
+    decided = []
     for (corners, sides, reflex), mids in zip(odd, all_mids):
         k = len(corners)
         targets = [mids[j] if mids[j] is not None else corners[(j + 1) % k]
@@ -115,13 +124,30 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
             centre = _centre_inside(vertices, outline, centre, targets, convex)
         if key in unsplit or not _centre_sees(vertices, outline, corners, reflex, centre,
                                               targets):
-            halves = [h for side in sides for h in side]
+            plan = None if key in unsplit or reflex else \
+                _peel_plan(vertices, edges, corners, sides)
+            if plan is not None:
+                peeled.append((corners, sides, plan, key))
+                decided.append(None)
+                continue
             why = "whose split could not be filled" if key in unsplit \
                 else "is too concave to split into quadrilaterals"
-            free_halves.append((halves, f"a {k}-cornered block near "
-                                f"{fmt(centre)} {why}"))
+            decided.append((f"a {k}-cornered block near {fmt(centre)} {why}",))
+            continue
+        decided.append((centre, targets))
+    peel_blocks = [block for corners, sides, plan, key in peeled
+                   for block in _peel(vertices, edges, holders, corners, sides, plan, key,
+                                      domain)]
+    for (corners, sides, reflex), mids, decision in zip(odd, all_mids, decided):
+        if decision is None:  # peeled
+            continue
+        if len(decision) == 1:
+            halves = [h for side in sides for h in side]
+            free_halves.append((halves, decision[0]))
             everything.append((None, [halves]))
             continue
+        k = len(corners)
+        centre, targets = decision
         c_id = len(vertices)
         vertices.append(centre)
         spoke = {}
@@ -150,6 +176,8 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
                                        ((spoke[before], True),), tuple(from_prev))))
     for corners, sides, at, key in halved:
         blocks.extend(_halves_of_hexagon(vertices, edges, corners, sides, at, key))
+    blocks.extend(Block(corners=tuple(c), sides=tuple(tuple(side) for side in s))
+                  for c, s in peel_blocks)
     for face in faces:
         if len(face[0]) == 4 and not face[2]:
             blocks.append(Block(corners=tuple(face[0]),
@@ -188,7 +216,7 @@ def _kernel(outline):
     for a, b in zip(outline, nxt):
         if np.hypot(*(b - a)) <= 1e-12 * scale:
             continue
-        side = _side_of(a, b, poly)
+        side = side_of(a, b, poly)
         keep = side >= 0.0
         if keep.all():
             continue
@@ -219,7 +247,7 @@ def _centre_sees(vertices, outline, corners, reflex, centre, targets) -> bool:
 
 
 def _spokes_inside(vertices, outline, centre, targets) -> bool:
-    return all(_inside(outline, centre, np.asarray(vertices[t])) for t in targets)
+    return all(segment_inside(outline, centre, np.asarray(vertices[t])) for t in targets)
 
 
 CENTRE_SHIFTS = (0.25, 0.5)  # of the way from the centre to a corner or target, tried
@@ -267,7 +295,7 @@ def _opposite_corners(vertices, edges, corners, sides):
     best, best_angle = None, MIN_CUT_ANGLE
     for k in range(3):
         a, b = np.asarray(vertices[corners[k]]), np.asarray(vertices[corners[k + 3]])
-        if not _inside(outline, a, b):
+        if not segment_inside(outline, a, b):
             continue
         angle = min(min(_split_angles(edges, sides, k, b - a)),
                     min(_split_angles(edges, sides, k + 3, a - b)))
@@ -283,42 +311,13 @@ def _split_angles(edges, sides, k, cut) -> tuple:
     arriving = _side_points(sides[k - 1], edges)[::-1]
     out = _heading(leaving)
     back = _heading(arriving)
-    return _ccw_angle(out, cut), _ccw_angle(cut, back)
-
-
-def _ccw_angle(u, v) -> float:
-    """Counter-clockwise angle from u to v, in [0, 2 pi)."""
-    return math.atan2(u[0] * v[1] - u[1] * v[0], float(u @ v)) % (2 * math.pi)
+    return ccw_angle(out, cut), ccw_angle(cut, back)
 
 
 def _heading(points) -> np.ndarray:
     """Direction from a polyline's start to its point a quarter of its length on."""
     cum = cumulative_length(points)
     return point_at(points, cum, 0.25 * float(cum[-1])) - points[0]
-
-
-def _inside(outline, a, b) -> bool:
-    """The segment a-b lies inside the closed outline: its middle inside, and no outline
-    segment away from its ends crosses it."""
-    if not inside_polygon(outline, (a + b) / 2):
-        return False
-    p, q = outline, np.roll(outline, -1, axis=0)
-    tol = 1e-9 * np.hypot(*(b - a))
-    away = (_distance_to_ends(p, a, b) > tol) & (_distance_to_ends(q, a, b) > tol)
-    d1, d2 = _side_of(a, b, p), _side_of(a, b, q)
-    d3, d4 = _side_of(p, q, a), _side_of(p, q, b)
-    hits = (d1 * d2 < 0) & (d3 * d4 < 0) & away
-    return not hits.any()
-
-
-def _distance_to_ends(points, a, b) -> np.ndarray:
-    return np.minimum(np.hypot(*(points - a).T), np.hypot(*(points - b).T))
-
-
-def _side_of(u, v, w) -> np.ndarray:
-    """Twice the signed area of (u, v, w), row by row: which side of u-v w lies on."""
-    return (v[..., 0] - u[..., 0]) * (w[..., 1] - u[..., 1]) \
-        - (v[..., 1] - u[..., 1]) * (w[..., 0] - u[..., 0])
 
 
 def _halves_of_hexagon(vertices, edges, corners, sides, k, key) -> list:
@@ -365,6 +364,57 @@ def _sides_holding(faces) -> dict:
             for e in dict.fromkeys(e for e, _ in side):
                 out.setdefault(e, []).append(side)
     return out
+
+
+def _peel_plan(vertices, edges, corners, sides):
+    """peel.peel_plan on a face's corners and sides as polylines."""
+    return peel_plan([vertices[c] for c in corners],
+                     [_side_points(side, edges) for side in sides])
+
+
+def _peel(vertices, edges, holders, corners, sides, plan, key, domain) -> list:
+    """The (corners, sides) of the quadrilaterals a face's peel plan cuts it into; each
+    foot splits its side (and whatever else holds that edge, through ``holders``), each
+    cut is an edge whose origin is the face's split key (a rebuild can take it away)."""
+    corners, sides = list(corners), list(sides)
+    quads = []
+    for c, j, s, snap in plan:
+        foot = _split_at(vertices, edges, holders, sides[j], s, snap, domain)
+        i = _mid_index(sides[j], edges, foot)
+        first, second = sides[j][: i + 1], sides[j][i + 1:]
+        cut = len(edges)
+        edges.append(Edge(points=np.linspace(vertices[corners[c]], vertices[foot], 8),
+                          a=corners[c], b=foot, origin=key))
+        out, back = [(cut, True)], [(cut, False)]
+        for side in (first, second, out, back):
+            for e in dict.fromkeys(e for e, _ in side):
+                holders.setdefault(e, []).append(side)
+        quad_corners, quad_sides, corners, sides = pieces(corners, sides, c, j, foot, first,
+                                                          second, out, back)
+        quads.append((quad_corners, quad_sides))
+    quads.append((corners, sides))
+    return quads
+
+
+def _split_at(vertices, edges, holders, side, s, snap, domain) -> int:
+    """Vertex id at arc length ``s`` of a side's polyline (its edges' points): an inner
+    vertex of the side within ``snap`` of it, else a new one splitting its edge."""
+    lengths = np.array([float(cumulative_length(edges[e].points)[-1]) for e, _ in side])
+    ends = np.cumsum(lengths)
+    inner = ends[:-1]
+    if len(inner):
+        k = int(np.argmin(np.abs(inner - s)))
+        if abs(inner[k] - s) <= snap:
+            return _head(edges, side[k])
+    k = min(int(np.searchsorted(ends, s)), len(side) - 1)
+    e, forward = side[k]
+    share = (s - (ends[k] - lengths[k])) / max(lengths[k], 1e-300)
+    share = min(max(share if forward else 1.0 - share, 0.0), 1.0)
+    new_vertex, tail = _split_edge(vertices, edges, e, share * edges[e].length, domain)
+    for other in holders.get(e, ()):
+        _replace_half(other, e, tail)
+    holders[tail] = list(holders.get(e, ()))
+    return new_vertex
 
 
 def _split_side(vertices, edges, holders, sides, j, domain) -> int:

@@ -1,0 +1,101 @@
+"""Faces no centre sees and no opposite-corner cut splits, cut from corners to sides into
+quadrilaterals (layout.peel, through layout.subdivide): held-out 0037's strip under a row
+of notches was a free face of unstructured quads at its default size."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from quadcnn_wb.core.layout import subdivide
+from quadcnn_wb.core.layout.face_geometry import segment_inside
+from quadcnn_wb.core.layout.partition_types import Edge
+from quadcnn_wb.core.layout.peel import peel_plan
+from quadcnn_wb.core.layout.subdivide import split_odd_faces
+
+TOP = [(15.55, -6.3), (11.4, -6.3), (11.4, -7.3), (10.6, -7.3), (10.6, -6.3), (-10.6, -6.3),
+       (-10.6, -7.3), (-11.4, -7.3), (-11.4, -6.3), (-15.55, -6.3)]
+
+
+def _notched_strip():
+    """Six corners, counter-clockwise: a strip 3.5 high and 34 long whose top side has two
+    notches (as 0037's did), each end a short step up: the diagonals between opposite
+    corners cross a notch, and the strip is too long for a centre's spokes."""
+    points = [(15.55, -6.3), (-15.55, -6.3), (-16.99, -5.91), (-17.05, -9.8), (17.05, -9.8),
+              (16.99, -5.91)]
+    corners = [np.array(p, dtype=float) for p in points]
+    edges = [Edge(points=np.array(TOP, dtype=float) if a == 0
+                  else np.linspace(corners[a], corners[(a + 1) % 6], 9), a=a, b=(a + 1) % 6)
+             for a in range(6)]
+    return corners, edges, [[(e, True)] for e in range(6)]
+
+
+def _outline(edges, sides) -> np.ndarray:
+    pts = []
+    for side in sides:
+        for e, forward in side:
+            p = edges[e].points if forward else edges[e].points[::-1]
+            pts.extend(p[:-1])
+    return np.array(pts)
+
+
+def _area(outline) -> float:
+    x, y = outline.T
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+@pytest.mark.parametrize("star", [False, True])
+def test_a_notched_strip_becomes_three_blocks_with_cuts_inside_it(star):
+    vertices, edges, sides = _notched_strip()
+    whole = _outline(edges, sides)
+    out, blocks, free = split_odd_faces(vertices, edges, [(list(range(6)), sides, ())], [],
+                                        None, star=star)
+    assert not free and len(blocks) == 3
+    assert all(len(block.corners) == 4 for block in blocks)
+    # The blocks tile the face: each a proper counter-clockwise outline, areas adding up.
+    areas = [_area(_outline(edges, block.sides)) for block in blocks]
+    assert min(areas) > 0.0
+    assert sum(areas) == pytest.approx(_area(whole), rel=1e-9)
+    cuts = [edge for edge in edges if edge.origin and edge.origin[0] == "split"]
+    assert len(cuts) == 2
+    for cut in cuts:
+        assert segment_inside(whole, cut.points[0], cut.points[0]
+                              + (1 - 1e-6) * (cut.points[-1] - cut.points[0]))
+        assert abs(cut.points[-1][1] + 9.8) < 1e-9  # the feet on the bottom side
+
+
+def test_without_the_cuts_the_strip_stays_a_free_face(monkeypatch):
+    monkeypatch.setattr(subdivide, "peel_plan", lambda corners, sides: None)
+    vertices, edges, sides = _notched_strip()
+    _, blocks, free = split_odd_faces(vertices, edges, [(list(range(6)), sides, ())], [], None)
+    assert not blocks and len(free) == 1
+
+
+def test_the_plan_is_the_same_for_a_turned_and_moved_copy():
+    vertices, edges, _ = _notched_strip()
+    plan = peel_plan(vertices, [edge.points for edge in edges])
+    assert plan is not None and len(plan) == 2
+    turn = math.radians(37.0)
+    rot = np.array([[math.cos(turn), -math.sin(turn)], [math.sin(turn), math.cos(turn)]])
+    shift = np.array([1e4, -2e4])
+    moved = peel_plan([rot @ v + shift for v in vertices],
+                      [edge.points @ rot.T + shift for edge in edges])
+    assert [step[:2] for step in moved] == [step[:2] for step in plan]
+    assert np.allclose([step[2:] for step in moved], [step[2:] for step in plan], rtol=1e-9,
+                       atol=1e-9)
+
+
+def test_a_ring_half_with_a_bent_end_gets_no_plan():
+    # 0043's ring half: the bend's neighbours face each other across the strip, so a
+    # foot would sit on a corner, and any other cut runs out of the curved strip.
+    t = np.linspace(math.radians(-30), math.radians(210), 60)
+    outer = np.column_stack([12 * np.cos(t), 12 * np.sin(t)])
+    inner = np.column_stack([10 * np.cos(t), 10 * np.sin(t)])[::-1]
+    bend = 11 * np.array([math.cos(math.radians(214)), math.sin(math.radians(214))])
+    corners = [outer[0], outer[-1], bend, inner[0], inner[-1]]
+    sides = [outer, np.vstack([outer[-1], bend]), np.vstack([bend, inner[0]]), inner,
+             np.vstack([inner[-1], outer[0]])]
+    assert _area(np.vstack([side[:-1] for side in sides])) > 0.0
+    assert peel_plan(corners, sides) is None
