@@ -34,6 +34,7 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
         ("broken", "default"), ("broken", "d100")}
     good = [r for r in written if r["name"] == "l_shape"]
     assert all(r["structured_share"] == 1.0 and r["quads"] > 0 for r in good)
+    assert not any("problem" in r for r in good)  # only rows with free faces say why
     assert all("open loop" in r["error"] for r in written if r["name"] == "open")
     assert all(r["error"] for r in written if r["name"] == "broken")  # a corrupt part
     assert "default: all in blocks 1/3 (2 errors)" in run.stdout

@@ -9,9 +9,10 @@ file (.brep .step .stp .iges .igs .json; JSON objects without "loops", such as a
 or a mesh result, are skipped and named) and size runs in a fresh Python with a time limit,
 so a hang or a crash costs that row only.  One line is printed per row and one JSON line
 appended to ROWS (name, size_kind, structured_share, irregular_vertices,
-min_scaled_jacobian, quads, mesh_s, wall_s, or error; mesh_s is timed after one small part
-meshed untimed in that process, wall_s is the whole process); then how many rows are all in
-blocks per size.  With --compare, the rows that differ from an earlier ROWS file (share,
+min_scaled_jacobian, quads, mesh_s, wall_s, or error; problem where some faces are no
+blocks, saying why; mesh_s is timed after one small part meshed untimed in that process,
+wall_s is the whole process); then how many rows are all in blocks per size.  With
+--compare, the rows that differ from an earlier ROWS file (share,
 irregular vertices, errors, or the worst scaled Jacobian by more than 0.01) are listed:
 what a change did to parts the tests do not hold.  With --gmsh, each row also holds gmsh's
 quasi-structured algorithm (Mesh.Algorithm 11) on the same face at the same size (its
@@ -66,6 +67,8 @@ def worker(path: str, kind: str, peer: bool = False, poses: bool = False) -> int
                 "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
                 "quads": int(len(result.mesh.quads)),
             })
+            if result.problem:  # which faces are no blocks, and why
+                row["problem"] = result.problem
             if poses:
                 row.update(_pose_row(domain, size))
     except Exception as exc:  # a refused file is a row too, with its message
