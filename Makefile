@@ -72,8 +72,9 @@ demo: setup
 lint: setup
 	$(VENV)/bin/ruff check .
 
+# One worker per core (pytest-xdist); the FreeCAD tests share one worker (xdist_group).
 test: setup lint
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadgroup
 
 # Speed figures (not part of the test suite).
 bench: setup

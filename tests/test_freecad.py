@@ -8,7 +8,12 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import pytest
 from conftest import REPO
+
+# One FreeCAD at a time: every instance writes the same user settings when it closes, so
+# the suite's parallel workers (pytest-xdist) run this module's tests in one of them.
+pytestmark = pytest.mark.xdist_group("freecad")
 
 FREECAD_ENV = {**os.environ, "LANG": "C.UTF-8", "QTWEBENGINE_CHROMIUM_FLAGS": "--no-sandbox"}
 # Plain freecadcmd must find our packages by itself: hide the venv from it.
