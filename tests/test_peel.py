@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from quadcnn_wb.core.layout import subdivide
+from quadcnn_wb.core.layout import peel, subdivide
 from quadcnn_wb.core.layout.face_geometry import segment_inside
 from quadcnn_wb.core.layout.partition_types import Edge
 from quadcnn_wb.core.layout.peel import peel_plan
@@ -87,9 +87,11 @@ def test_the_plan_is_the_same_for_a_turned_and_moved_copy():
                        atol=1e-9)
 
 
-def test_a_ring_half_with_a_bent_end_gets_no_plan():
-    # 0043's ring half: the bend's neighbours face each other across the strip, so a
-    # foot would sit on a corner, and any other cut runs out of the curved strip.
+def _ring_half_with_a_bent_end():
+    """Five corners, counter-clockwise: a ring's half (radii 10 and 12) whose end at 210°
+    bends out to a point between the radii (0043's ring half at its default size): the
+    end's two other corners face each other across the strip, so the side point nearest
+    either is the other corner."""
     t = np.linspace(math.radians(-30), math.radians(210), 60)
     outer = np.column_stack([12 * np.cos(t), 12 * np.sin(t)])
     inner = np.column_stack([10 * np.cos(t), 10 * np.sin(t)])[::-1]
@@ -97,5 +99,23 @@ def test_a_ring_half_with_a_bent_end_gets_no_plan():
     corners = [outer[0], outer[-1], bend, inner[0], inner[-1]]
     sides = [outer, np.vstack([outer[-1], bend]), np.vstack([bend, inner[0]]), inner,
              np.vstack([inner[-1], outer[0]])]
+    return corners, sides
+
+
+def test_a_ring_half_with_a_bent_end_is_cut_slanting_across_near_that_end():
+    corners, sides = _ring_half_with_a_bent_end()
     assert _area(np.vstack([side[:-1] for side in sides])) > 0.0
-    assert peel_plan(corners, sides) is None
+    plan = peel_plan(corners, sides)
+    assert plan is not None and len(plan) == 1
+    c, j, s, _ = plan[0]
+    # From an end corner to the other arc, a little along it from the corner facing it
+    # (the nearest point, that corner itself, leaves no room for a quad).
+    assert (c, j) in ((1, 3), (3, 0))
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(sides[j], axis=0).T))])
+    from_end = s if j == 3 else cum[-1] - s
+    assert 0.3 < from_end < 2.0
+
+
+def test_without_other_feet_the_ring_half_gets_no_plan(monkeypatch):
+    monkeypatch.setattr(peel, "FOOT_STEPS", (0,))
+    assert peel_plan(*_ring_half_with_a_bent_end()) is None

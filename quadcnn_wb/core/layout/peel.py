@@ -26,6 +26,8 @@ from .face_geometry import ccw_angle, segment_inside
 MIN_CUT_ANGLE = math.radians(30.0)
 FOOT_CLEARANCE = 0.25  # the foot stays this many cut lengths from the side's corners
 FOOT_SNAP = 0.1  # ... and takes a vertex already on the side this many cut lengths away
+FOOT_STEP = 0.25  # of the nearest foot's distance: how far apart the other feet tried lie
+FOOT_STEPS = (0, -1, 1, -2, 2, -3, 3, -4, 4)
 INSIDE_SHORT = 1e-6  # share of a cut left out at its foot when testing it is inside
 HEADING_SHARE = 0.25  # a side's heading at a corner: this share of its length on ...
 HEADING_CUT = 0.5  # ... but no farther than this share of the cut's length
@@ -87,15 +89,40 @@ def pieces(corners, sides, c, j, foot, first, second, cut_out, cut_back) -> tupl
 
 
 def _cut_to_side(corners, sides, outline, c, j):
-    """(least angle, arc length, foot) of the cut from corner c to the nearest point of
-    side j, or None where it leaves the face, ends too near the side's corners or makes
-    an angle under MIN_CUT_ANGLE."""
+    """(least angle, arc length, foot) of the best cut from corner c to side j, or None
+    where every one leaves the face, ends too near the side's corners or makes an angle
+    under MIN_CUT_ANGLE.  The feet tried: the side's point nearest the corner, then
+    FOOT_STEP of that distance further either way (a strip's end whose corners face each
+    other across it has its nearest point on a corner: 0043's ring half, whose cut then
+    slants, halving the corner's angle)."""
     corner = corners[c]
     pts = sides[j]
-    s, foot, tangent = _nearest_on(pts, corner)
+    cum = cumulative_length(pts)
+    nearest, foot, _ = _nearest_on(pts, corner)
+    width = float(np.hypot(*(foot - corner)))
+    if not width > 0.0:
+        return None
+    best = None
+    for step in FOOT_STEPS:
+        s = nearest + step * FOOT_STEP * width
+        if not 0.0 < s < float(cum[-1]):
+            continue
+        found = _cut_at(corners, sides, outline, c, j, s, cum)
+        if found is not None and (best is None or found[0] > best[0] + 1e-9):
+            best = found
+    return best
+
+
+def _cut_at(corners, sides, outline, c, j, s, cum):
+    """_cut_to_side's figures for the foot at arc length s of side j."""
+    corner = corners[c]
+    pts = sides[j]
+    k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(pts) - 2))
+    foot = point_at(pts, cum, s)
+    tangent = pts[k + 1] - pts[k]
+    tangent = tangent / max(float(np.hypot(*tangent)), 1e-300)
     length = float(np.hypot(*(foot - corner)))
-    total = float(cumulative_length(pts)[-1])
-    if not length > 0.0 or min(s, total - s) < FOOT_CLEARANCE * length:
+    if not length > 0.0 or min(s, float(cum[-1]) - s) < FOOT_CLEARANCE * length:
         return None
     # The foot lies on the outline: tested short of it, so round-off there cannot
     # read as a crossing.

@@ -400,6 +400,22 @@ def _split_at(vertices, edges, holders, side, s, snap, domain) -> int:
     """Vertex id at arc length ``s`` of a side's polyline (its edges' points): an inner
     vertex of the side within ``snap`` of it, else a new one splitting its edge."""
     lengths = np.array([float(cumulative_length(edges[e].points)[-1]) for e, _ in side])
+    return _vertex_along(vertices, edges, holders, side, lengths, s, snap, domain)
+
+
+def _split_side(vertices, edges, holders, sides, j, domain) -> int:
+    """Vertex id in the middle of side j (an existing one, or a new one from a split);
+    ``holders``: _sides_holding's map, kept up to date."""
+    lengths = np.array([edges[e].length for e, _ in sides[j]])
+    total = float(lengths.sum())
+    return _vertex_along(vertices, edges, holders, sides[j], lengths, total / 2,
+                         MIDPOINT_SNAP * total, domain)
+
+
+def _vertex_along(vertices, edges, holders, side, lengths, s, snap, domain) -> int:
+    """Vertex id at ``s`` along a side whose half-edges measure ``lengths``: an inner
+    vertex within ``snap``, else a new one splitting the half-edge holding it (and every
+    side that holds that edge, through ``holders``)."""
     ends = np.cumsum(lengths)
     inner = ends[:-1]
     if len(inner):
@@ -408,33 +424,11 @@ def _split_at(vertices, edges, holders, side, s, snap, domain) -> int:
             return _head(edges, side[k])
     k = min(int(np.searchsorted(ends, s)), len(side) - 1)
     e, forward = side[k]
-    share = (s - (ends[k] - lengths[k])) / max(lengths[k], 1e-300)
-    share = min(max(share if forward else 1.0 - share, 0.0), 1.0)
-    new_vertex, tail = _split_edge(vertices, edges, e, share * edges[e].length, domain)
-    for other in holders.get(e, ()):
-        _replace_half(other, e, tail)
-    holders[tail] = list(holders.get(e, ()))
-    return new_vertex
-
-
-def _split_side(vertices, edges, holders, sides, j, domain) -> int:
-    """Vertex id in the middle of side j (an existing one, or a new one from a split);
-    ``holders``: _sides_holding's map, kept up to date."""
-    side = sides[j]
-    lengths = np.array([edges[e].length for e, _ in side])
-    total = float(lengths.sum())
-    ends = np.cumsum(lengths)
-    inner = ends[:-1]
-    if len(inner):
-        k = int(np.argmin(np.abs(inner - total / 2)))
-        if abs(inner[k] - total / 2) <= MIDPOINT_SNAP * total:
-            return _head(edges, side[k])
-    # Split the half-edge holding the middle.
-    k = int(np.searchsorted(ends, total / 2))
-    e, forward = side[k]
-    along = total / 2 - (ends[k] - lengths[k])
-    s = along if forward else lengths[k] - along  # arc length from the edge's start
-    new_vertex, tail = _split_edge(vertices, edges, e, s, domain)
+    along = s - (ends[k] - lengths[k])
+    at = along if forward else lengths[k] - along  # from the edge's start, in ``lengths``
+    if lengths[k] != edges[e].length:  # a polyline's measure: the edge's own along it
+        at = min(max(at / max(lengths[k], 1e-300), 0.0), 1.0) * edges[e].length
+    new_vertex, tail = _split_edge(vertices, edges, e, at, domain)
     for other in holders.get(e, ()):
         _replace_half(other, e, tail)
     holders[tail] = list(holders.get(e, ()))
