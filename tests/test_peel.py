@@ -119,3 +119,22 @@ def test_a_ring_half_with_a_bent_end_is_cut_slanting_across_near_that_end():
 def test_without_other_feet_the_ring_half_gets_no_plan(monkeypatch):
     monkeypatch.setattr(peel, "FOOT_STEPS", (0,))
     assert peel_plan(*_ring_half_with_a_bent_end()) is None
+
+
+def _interior_angle(corners, k) -> float:
+    a, b, c = (np.asarray(corners[i % len(corners)], dtype=float) for i in (k - 1, k, k + 1))
+    u, v = c - b, a - b
+    return math.atan2(u[0] * v[1] - u[1] * v[0], float(u @ v)) % (2 * math.pi)
+
+
+def test_a_cut_from_a_wide_corner_goes_before_a_wider_angle_from_a_narrow_one(monkeypatch):
+    # A pentagon (found by search among random ones) whose widest least angle is a cut
+    # from a corner under 135°: that corner would get two quads where its angle asks one.
+    corners = [np.array(p) for p in ((1.5, 0.4), (1.7, 0.9), (-1.4, 0.5), (-3.4, -0.2),
+                                     (-0.7, -1.2))]
+    sides = [np.linspace(corners[i], corners[(i + 1) % 5], 5) for i in range(5)]
+    (c, _, _, _), = peel_plan(corners, sides)
+    assert _interior_angle(corners, c) >= math.radians(135.0)
+    monkeypatch.setattr(peel, "WIDE_CORNER", 10.0)
+    (other, _, _, _), = peel_plan(corners, sides)
+    assert _interior_angle(corners, other) < math.radians(135.0)

@@ -8,10 +8,11 @@ two opposite corners inside it; it used to stay a free face of unstructured quad
 cut from a corner to the nearest point of a side two corners on splits off a
 quadrilateral and leaves a face of one corner fewer: a pentagon is two blocks, a
 hexagon a block and a pentagon.  The cut's ends are a corner that gets one more edge and
-a T on a side (regular, as any trace's end on a side), so no valence-5 centre either.
-Each cut must stay inside the face and leave at least MIN_CUT_ANGLE at both of its ends;
-of those, the one whose least angle is widest is taken (a tie goes to the face's first
-corner, as the hexagon's opposite-corner cut does).
+a T on a side (regular, as any trace's end on a side), so no valence-5 centre either;
+the corner is regular too where it is wide (WIDE_CORNER), so cuts from wide corners go
+first.  Each cut must stay inside the face and leave at least MIN_CUT_ANGLE at both of
+its ends; of those, the one whose least angle is widest is taken (a tie goes to the
+face's first corner, as the hexagon's opposite-corner cut does).
 """
 
 from __future__ import annotations
@@ -24,6 +25,9 @@ from .crossings import cumulative_length, point_at
 from .face_geometry import ccw_angle, segment_inside
 
 MIN_CUT_ANGLE = math.radians(30.0)
+# A corner this wide takes two quads as a regular vertex does (DESIGN.md's round(angle /
+# 90°)): a cut from it costs no irregular vertex, one from a narrower corner does.
+WIDE_CORNER = math.radians(135.0)
 FOOT_CLEARANCE = 0.25  # the foot stays this many cut lengths from the side's corners
 FOOT_SNAP = 0.1  # ... and takes a vertex already on the side this many cut lengths away
 FOOT_STEP = 0.25  # of the nearest foot's distance: how far apart the other feet tried lie
@@ -49,7 +53,7 @@ def peel_plan(corner_xy, side_points) -> list | None:
         for c in range(k):
             for j in sorted({(c + 2) % k, (c - 3) % k}):
                 found = _cut_to_side(corners, sides, outline, c, j)
-                if found is not None and (best is None or found[0] > best[0] + 1e-9):
+                if found is not None and (best is None or _better(found[0], best[0])):
                     best = (found[0], c, j, found[1], found[2])
         if best is None:
             return None
@@ -89,12 +93,12 @@ def pieces(corners, sides, c, j, foot, first, second, cut_out, cut_back) -> tupl
 
 
 def _cut_to_side(corners, sides, outline, c, j):
-    """(least angle, arc length, foot) of the best cut from corner c to side j, or None
-    where every one leaves the face, ends too near the side's corners or makes an angle
-    under MIN_CUT_ANGLE.  The feet tried: the side's point nearest the corner, then
-    FOOT_STEP of that distance further either way (a strip's end whose corners face each
-    other across it has its nearest point on a corner: 0043's ring half, whose cut then
-    slants, halving the corner's angle)."""
+    """((wide corner, least angle), arc length, foot) of the best cut from corner c to
+    side j (see _better), or None where every one leaves the face, ends too near the
+    side's corners or makes an angle under MIN_CUT_ANGLE.  The feet tried: the side's
+    point nearest the corner, then FOOT_STEP of that distance further either way (a
+    strip's end whose corners face each other across it has its nearest point on a
+    corner: 0043's ring half, whose cut then slants, halving the corner's angle)."""
     corner = corners[c]
     pts = sides[j]
     cum = cumulative_length(pts)
@@ -108,7 +112,7 @@ def _cut_to_side(corners, sides, outline, c, j):
         if not 0.0 < s < float(cum[-1]):
             continue
         found = _cut_at(corners, sides, outline, c, j, s, cum)
-        if found is not None and (best is None or found[0] > best[0] + 1e-9):
+        if found is not None and (best is None or _better(found[0], best[0])):
             best = found
     return best
 
@@ -135,7 +139,16 @@ def _cut_at(corners, sides, outline, c, j, s, cum):
     across = math.acos(float(np.clip(-cut @ tangent / length, -1.0, 1.0)))
     angles = at_corner + (across, math.pi - across)
     least = min(angles)
-    return (least, s, foot) if least >= MIN_CUT_ANGLE else None
+    wide = at_corner[0] + at_corner[1] >= WIDE_CORNER
+    return ((wide, least), s, foot) if least >= MIN_CUT_ANGLE else None
+
+
+def _better(first, second) -> bool:
+    """A cut from a wide corner first, then the wider least angle (ties, within
+    round-off, keep the earlier)."""
+    if first[0] != second[0]:
+        return first[0]
+    return first[1] > second[1] + 1e-9
 
 
 def _heading(points, cut_length) -> np.ndarray:
