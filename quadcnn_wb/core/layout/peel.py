@@ -102,7 +102,7 @@ def _cut_to_side(corners, sides, outline, c, j):
     corner = corners[c]
     pts = sides[j]
     cum = cumulative_length(pts)
-    nearest, foot, _ = _nearest_on(pts, corner)
+    nearest, foot = _nearest_on(pts, corner)
     width = float(np.hypot(*(foot - corner)))
     if not width > 0.0:
         return None
@@ -158,7 +158,7 @@ def _heading(points, cut_length) -> np.ndarray:
 
 
 def _nearest_on(points, p) -> tuple:
-    """(arc length, point, unit tangent) of a polyline's point nearest to p."""
+    """(arc length, point) of a polyline's point nearest to p."""
     a, b = points[:-1], points[1:]
     d = b - a
     lengths = np.hypot(*d.T)
@@ -167,4 +167,4 @@ def _nearest_on(points, p) -> tuple:
     gap = np.hypot(*(near - p).T)
     i = int(np.argmin(gap))
     s = float(np.concatenate([[0.0], np.cumsum(lengths)])[i] + f[i] * lengths[i])
-    return s, near[i], d[i] / max(lengths[i], 1e-300)
+    return s, near[i]

@@ -128,26 +128,26 @@ def split_odd_faces(vertices: list, edges: list, faces: list, free: list, domain
                 _peel_plan(vertices, edges, corners, sides)
             if plan is not None:
                 peeled.append((corners, sides, plan, key))
-                decided.append(None)
+                decided.append(("peeled",))
                 continue
             why = "whose split could not be filled" if key in unsplit \
                 else "is too concave to split into quadrilaterals"
-            decided.append((f"a {k}-cornered block near {fmt(centre)} {why}",))
+            decided.append(("free", f"a {k}-cornered block near {fmt(centre)} {why}"))
             continue
-        decided.append((centre, targets))
+        decided.append(("star", centre, targets))
     peel_blocks = [block for corners, sides, plan, key in peeled
                    for block in _peel(vertices, edges, holders, corners, sides, plan, key,
                                       domain)]
     for (corners, sides, reflex), mids, decision in zip(odd, all_mids, decided):
-        if decision is None:  # peeled
+        if decision[0] == "peeled":  # its blocks are in peel_blocks
             continue
-        if len(decision) == 1:
+        if decision[0] == "free":
             halves = [h for side in sides for h in side]
-            free_halves.append((halves, decision[0]))
+            free_halves.append((halves, decision[1]))
             everything.append((None, [halves]))
             continue
         k = len(corners)
-        centre, targets = decision
+        _, centre, targets = decision
         c_id = len(vertices)
         vertices.append(centre)
         spoke = {}
@@ -361,9 +361,14 @@ def _sides_holding(faces) -> dict:
     out: dict = {}
     for _, sides in faces:
         for side in sides:
-            for e in dict.fromkeys(e for e, _ in side):
-                out.setdefault(e, []).append(side)
+            _hold(out, side)
     return out
+
+
+def _hold(holders, side) -> None:
+    """Register a side list under each edge it holds (once per edge)."""
+    for e in dict.fromkeys(e for e, _ in side):
+        holders.setdefault(e, []).append(side)
 
 
 def _peel_plan(vertices, edges, corners, sides):
@@ -387,8 +392,7 @@ def _peel(vertices, edges, holders, corners, sides, plan, key, domain) -> list:
                           a=corners[c], b=foot, origin=key))
         out, back = [(cut, True)], [(cut, False)]
         for side in (first, second, out, back):
-            for e in dict.fromkeys(e for e, _ in side):
-                holders.setdefault(e, []).append(side)
+            _hold(holders, side)
         quad_corners, quad_sides, corners, sides = pieces(corners, sides, c, j, foot, first,
                                                           second, out, back)
         quads.append((quad_corners, quad_sides))
