@@ -405,3 +405,43 @@ def test_boundary_nodes_slide_across_smooth_joints_but_not_past_corners():
     assert hi - lo == pytest.approx(sum(c.length for c in loop[3:33]))
     middle = chain.point(0.5 * (lo + hi))
     assert np.hypot(*(middle - [2, 2])) == pytest.approx(1.0, abs=0.01)  # on the arc
+
+
+def test_corner_jacobians_match_the_design_formula_bit_for_bit():
+    """The fast form (one edge array, the previous edge reversed) must give exactly
+    DESIGN.md's (a x b) / (|a||b|) with a to the next corner and b to the previous: the
+    max-min moves compare these values for ties, so a last-bit change would move nodes."""
+    from quadcnn_wb.core.mesh.improve import corner_jacobians
+
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(500, 4, 2)) * np.exp(rng.normal(size=(500, 4, 2)) * 4)
+    p[0] = p[0, 0]  # all corners on one point
+    p[1, 1] = p[1, 0]  # one zero-length edge
+    fast = corner_jacobians(p)
+    for q in range(len(p)):
+        for k in range(4):
+            a = p[q, (k + 1) % 4] - p[q, k]
+            b = p[q, (k - 1) % 4] - p[q, k]
+            norm = np.hypot(*a) * np.hypot(*b)
+            expected = (a[0] * b[1] - a[1] * b[0]) / norm if norm > 0 else -1.0
+            assert fast[q, k] == expected
+
+
+def test_neighbour_means_are_the_plain_average_bit_for_bit():
+    """Smoothing's average of each node's edge neighbours, summed in the order of the
+    edge list (first ends, then second ends), as a loop would."""
+    from quadcnn_wb.core.mesh.edge_graph import edge_graph, neighbour_means
+
+    rng = np.random.default_rng(4)
+    quads = rng.integers(0, 300, size=(400, 4))
+    x = rng.normal(size=(310, 2)) * 1e3
+    edges, degree = edge_graph(quads, len(x))
+    means = neighbour_means(x, edges, degree)
+    summed = np.zeros_like(x)
+    for i, j in edges:
+        summed[i] += x[j]
+    for i, j in edges:
+        summed[j] += x[i]
+    used = degree > 0
+    assert np.array_equal(means[used], summed[used] / degree[used, None])
+    assert np.isnan(means[~used]).all()

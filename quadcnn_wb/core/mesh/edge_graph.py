@@ -15,8 +15,13 @@ def edge_graph(quads, n: int) -> tuple:
 
 def neighbour_means(x, edges, degree) -> np.ndarray:
     """Mean of each node's edge neighbours (rows of nodes on no edge are 0/0)."""
-    summed = np.zeros_like(x)
-    np.add.at(summed, edges[:, 0], x[edges[:, 1]])
-    np.add.at(summed, edges[:, 1], x[edges[:, 0]])
+    # bincount adds in the order of its input, as np.add.at did (first every edge's
+    # first node, then every second node): the same sums, bit for bit, several times
+    # faster (smoothing calls this hundreds of times a mesh).
+    at = np.concatenate([edges[:, 0], edges[:, 1]])
+    other = np.concatenate([edges[:, 1], edges[:, 0]])
+    n = len(x)
+    summed = np.stack([np.bincount(at, weights=x[other, k], minlength=n)
+                       for k in range(x.shape[1])], axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return summed / degree[:, None]

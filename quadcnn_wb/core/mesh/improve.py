@@ -56,9 +56,14 @@ def corner_jacobians(p) -> np.ndarray:
     this a million times on a big free face (np.roll was a quarter of perforated_plate's
     meshing time)."""
     a = p[..., NEXT_CORNER, :] - p
-    b = p[..., PREVIOUS_CORNER, :] - p
-    cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    norm = np.hypot(a[..., 0], a[..., 1]) * np.hypot(b[..., 0], b[..., 1])
+    # The edge to the previous corner is the previous corner's edge reversed: IEEE
+    # subtraction and products are exactly odd, so -(x - y) == y - x and the cross product
+    # below equals a x b with b = p[previous] - p, bit for bit, with one edge array and one
+    # hypot fewer.
+    back = a[..., PREVIOUS_CORNER, :]
+    cross = a[..., 1] * back[..., 0] - a[..., 0] * back[..., 1]
+    length = np.hypot(a[..., 0], a[..., 1])
+    norm = length * length[..., PREVIOUS_CORNER]
     return np.where(norm > 0, cross / np.maximum(norm, 1e-300), -1.0)
 
 
@@ -123,7 +128,11 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
     for _ in range(passes):
         # Rounded and stable: a turned copy of the mesh visits the same nodes in the same
         # order (rounding noise must not reorder near-ties).
-        sj = np.round(sj_batch(x[quads]), 12)
+        # Each quad's scaled Jacobian, kept up to date as nodes move: the values a fresh
+        # computation from the current corners would give, bit for bit (same formula on
+        # the same coordinates), without one per node visited.
+        live = sj_batch(x[quads])
+        sj = np.round(live, 12)
         if among is None:
             worst = np.argsort(sj, kind="stable")[: max(4, int(share * len(quads)))]
         else:
@@ -138,7 +147,7 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
             incident = order[starts[v]:starts[v + 1]] // 4
             around = quads[incident]
             corners = x[around]  # (k, 4, 2)
-            current = sj_batch(corners).min()
+            current = live[incident].min()
             if slide is not None and current >= SLIDE_BELOW and not strip[incident].any():
                 continue
             trial, ts = _slide_trials(slide, slides) if slide is not None \
@@ -166,11 +175,14 @@ def improve_worst(nodes, quads, fixed, passes: int = 12, share: float = 0.02,
                     point = slide.curve.point(t)
                 mid = corners.copy()
                 mid[around == v] = point
-                if not round(float(sj_batch(mid).min()), 9) > current + 1e-9:
+                moved_sj = sj_batch(mid)
+                if not round(float(moved_sj.min()), 9) > current + 1e-9:
                     continue
             else:
                 point, t = trial[tied[0]], (ts[tied[0]] if slide is not None else None)
+                moved_sj = around_sj[tied[0]]
             x[v] = point
+            live[incident] = moved_sj
             if slide is not None:
                 slide.t = t
             improved = True
