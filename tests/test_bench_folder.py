@@ -23,11 +23,14 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
         {"loops": [[{"line": [[0, 0], [1, 0]]}, {"line": [[1, 0], [1, 1]]}]]}))
     (parts / "notes.txt").write_text("not a part")
     (parts / "manifest.json").write_text(json.dumps({"l_shape": {"source": "bundled"}}))
+    # A list, as tests/corpus/manifest.json is: no part either.
+    (parts / "sources.json").write_text(json.dumps([{"name": "l_shape", "file": "x"}]))
     (parts / "broken.json").write_text('{"loops": [')
     rows = tmp_path / "rows.jsonl"
     run = run_folder(parts, "--rows", rows, "--time-limit", 300)
     assert run.returncode == 0, run.stderr
-    assert "skipped (JSON of something else: no 'loops'): manifest.json" in run.stdout
+    assert "skipped (JSON of something else: no 'loops'): manifest.json, sources.json" \
+        in run.stdout
     written = [json.loads(line) for line in rows.read_text().splitlines()]
     assert {(r["name"], r["size_kind"]) for r in written} == {
         ("l_shape", "default"), ("l_shape", "d100"), ("open", "default"), ("open", "d100"),

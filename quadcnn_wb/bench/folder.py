@@ -190,16 +190,17 @@ def load_rows(path) -> dict:
 
 
 def holds_a_part(path: Path) -> bool:
-    """False for a JSON file that is plainly something else (an object without "loops":
-    a folder's manifest, a mesh result the command line wrote); a file that does not
-    parse is a part, whose row then names what is wrong with it."""
+    """False for a JSON file that is plainly something else (a list, such as the
+    corpus's manifest, or an object without "loops": a mesh result the command line
+    wrote); a file that does not parse is a part, whose row then names what is wrong
+    with it."""
     if path.suffix.lower() != ".json":
         return True
     try:
         data = json.loads(path.read_text())
     except (OSError, ValueError):
         return True
-    return not isinstance(data, dict) or "loops" in data
+    return isinstance(data, dict) and "loops" in data
 
 
 def differs(a, b) -> bool:
