@@ -55,7 +55,17 @@ BAD_DOMAINS = {
     "hole crosses outer": ({"loops": [rect(2, 1), circle(2, 0.5, 0.3)]},
                            r"loops 0 and 1 intersect: loop 0 segment 1 and loop 1 segment 0"),
     "hole touches outer": ({"loops": [rect(2, 1), circle(1, 0.5, 0.5)]},
-                           r"loops 0 and 1 intersect"),
+                           r"loops 0 and 1 touch: .* meet at .*: the face pinches to no "
+                           r"width there"),
+    # Two holes of a real part that meet at one point (a slot cut up to a keyhole's rim:
+    # fsr-dance-pad's breadboard platform, face 103).
+    "holes touch": ({"loops": [rect(4, 4), circle(1, 1, 0.5), circle(2, 1, 0.5)]},
+                    r"loops 1 and 2 touch: loop 1 segment 0 and loop 2 segment 0 meet at "
+                    r"\(1.5, 1\): the face pinches"),
+    "hole corner on a hole": ({"loops": [rect(4, 4), circle(1, 1, 0.5),
+                                         [L([1.5, 1], [2.5, 0.5]), L([2.5, 0.5], [2.5, 1.5]),
+                                          L([2.5, 1.5], [1.5, 1])]]},
+                              r"loops 1 and 2 touch"),
     "holes overlap": ({"loops": [rect(4, 4), circle(1, 1, 0.5), circle(1.5, 1, 0.5)]},
                       r"loops 1 and 2 intersect"),
     "same hole twice": ({"loops": [rect(4, 4), circle(1, 1, 0.5), circle(1, 1, 0.5)]},

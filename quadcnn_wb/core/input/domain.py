@@ -266,7 +266,25 @@ def _check_intersections(loops, eps: float, heal: float) -> None:
         near = 10 * eps + math.sqrt(2.0 * heal * radius)
         for p in points:
             if all(np.hypot(*(p - v)) > near for v in allowed):
-                raise DomainError(_pair_message(li, si, lj, sj, f"cross at {_fmt(p)}"))
+                if _crossing(ci, cj, p, eps):
+                    raise DomainError(_pair_message(li, si, lj, sj, f"cross at {_fmt(p)}"))
+                raise DomainError(_pair_message(li, si, lj, sj, f"meet at {_fmt(p)}",
+                                                "touch") + ": the face pinches to no width "
+                                  "there")
+
+
+def _crossing(c1, c2, p, eps: float) -> bool:
+    """Whether two curves that meet at p pass through each other there, rather than
+    touch (an end of either on the other, or tangent curves: two holes of a real part
+    that meet at one point, where the face between them has no width)."""
+    for c in (c1, c2):
+        if min(np.hypot(*(p - c.p0)), np.hypot(*(p - c.p1))) <= 10 * eps:
+            return False
+    t1, t2 = c1.tangent(c1.project(p)), c2.tangent(c2.project(p))
+    return abs(float(t1[0] * t2[1] - t1[1] * t2[0])) > TANGENT_SINE
+
+
+TANGENT_SINE = 1e-6  # curves meeting at a smaller angle (radians) touch, they do not cross
 
 
 def _shared_vertices(loops, li, si, lj, sj) -> list:
@@ -281,10 +299,11 @@ def _shared_vertices(loops, li, si, lj, sj) -> list:
     return out
 
 
-def _pair_message(li, si, lj, sj, what: str) -> str:
+def _pair_message(li, si, lj, sj, what: str, verb: str = "intersect") -> str:
     if li == lj:
-        return f"loop {li} intersects itself: segments {si} and {sj} {what}"
-    return (f"loops {li} and {lj} intersect: loop {li} segment {si} and loop {lj} "
+        return f"loop {li} {verb}es itself: segments {si} and {sj} {what}" \
+            if verb == "touch" else f"loop {li} {verb}s itself: segments {si} and {sj} {what}"
+    return (f"loops {li} and {lj} {verb}: loop {li} segment {si} and loop {lj} "
             f"segment {sj} {what}")
 
 
