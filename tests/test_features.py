@@ -316,3 +316,33 @@ def test_a_fillet_stored_as_two_arcs_is_one_corner():
     corners = [f for f in features if f.angle is not None]
     assert len(corners) == 1 and round(math.degrees(corners[0].angle), 6) == 270.0
     assert corners[0].pivot_segment in (3, 4)  # at the middle of the two arcs
+
+
+def two_chamfers_plate():
+    """A 16.5 x 8.1 plate with its two bottom corners chamfered 0.1 x 0.1, like
+    fsr-dance-pad's breadboard platform (face 118) scaled by a tenth: four 135° joints,
+    two of them needed as corners and no rule in the ties alone to say which."""
+    return polygon([[0.1, 0.0], [16.4, 0.0], [16.5, 0.1], [16.5, 8.1], [0.0, 8.1],
+                    [0.0, 0.1]])
+
+
+def test_chamfers_that_leave_the_loops_turn_ambiguous_are_one_corner_each():
+    domain = domain_from_json({"loops": [two_chamfers_plate()]})
+    size = 0.183  # the chamfers (0.14 long) are 0.77 sizes: above FEATURE, no feature
+    features = boundary_features(domain, size)
+    assert summary(features) == [(2, 90.0), (2, 90.0)]  # each chamfer: both its joints
+    assert sorted(f.pivot_param for f in features) == pytest.approx([0.5, 0.5])  # middles
+
+
+@pytest.mark.parametrize("matrix", [rotation(0), rotation(37), rotation(211, mirror=True)],
+                         ids=["as drawn", "turned", "turned+mirrored"])
+def test_a_plate_with_two_small_chamfers_is_all_blocks_in_every_pose(matrix):
+    """Without the chamfers read as corners the plate had two corners, no singular point,
+    and every quad unstructured."""
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    data = transform_domain({"loops": [two_chamfers_plate()]}, matrix, shift=(1e4, -7.0))
+    result = mesh_domain(domain_from_json(data), 0.183)
+    q = result.quality
+    assert result.structured_share == 1.0
+    assert (q["blocks"], q["irregular_vertices"]) == (1, 2)  # the chamfers' middles

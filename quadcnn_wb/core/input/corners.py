@@ -105,19 +105,26 @@ def odd_ties(domain) -> frozenset:
     a corner cannot do without)."""
     out = set()
     for li, loop in enumerate(domain.loops):
-        if len(loop) < 2:
-            continue
-        short = 4 if li == 0 else -4
-        helping = []
-        for k in range(len(loop)):
-            angle = interior_angle(loop[k - 1], loop[k])
-            if not is_corner(angle):
-                continue
-            quarters = nearest_quarters(angle)
-            short -= 2 - quarters
-            if at_quarter_tie(angle) and angle > math.pi / 2:
-                helping.append((k, tie_quarters(angle) - quarters))
-        helping = [k for k, step in helping if short and step == (-1 if short > 0 else 1)]
+        short, helping = tie_shortfall(li, loop)
         if helping and len(helping) == abs(short):
             out.update((li, k) for k in helping)
     return frozenset(out)
+
+
+def tie_shortfall(li: int, loop) -> tuple[int, list]:
+    """(R, joints): the quarter turns R by which a loop's corners, rounded the even way,
+    fall short of its whole turn, and the tie joints (odd multiples of 45°, not 45°)
+    whose odd count would make up one quarter of it each (odd_ties, features' chamfers)."""
+    if len(loop) < 2:
+        return 0, []
+    short = 4 if li == 0 else -4
+    helping = []
+    for k in range(len(loop)):
+        angle = interior_angle(loop[k - 1], loop[k])
+        if not is_corner(angle):
+            continue
+        quarters = nearest_quarters(angle)
+        short -= 2 - quarters
+        if at_quarter_tie(angle) and angle > math.pi / 2:
+            helping.append((k, tie_quarters(angle) - quarters))
+    return short, [k for k, step in helping if short and step == (-1 if short > 0 else 1)]

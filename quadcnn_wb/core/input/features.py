@@ -63,7 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .corners import interior_angle, is_corner, nearest_quarters
+from .corners import interior_angle, is_corner, nearest_quarters, tie_shortfall
 from .small_holes import field_direction, is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
@@ -207,6 +207,40 @@ def _loop_features(li, loop, size) -> list:
             chain = []
     for chain in chains:
         feature = _feature(li, loop, chain, total, size)
+        if feature is not None:
+            out.append(feature)
+    return out + _chamfers(li, loop, out, size)
+
+
+def _chamfers(li, loop, features, size) -> list:
+    """Chamfers read as one corner each where the loop's ties leave its turn ambiguous.
+
+    A rectangle with two corners chamfered an element wide has four 135° joints, each a
+    tie between one quad and two; the loop's corners, rounded the even way, are two, and
+    any two of the four ties could make up the missing quarters (input.corners.odd_ties
+    leaves such a loop alone: no rule picks which).  Read that way the part had two
+    corners and no singular point, and all of it got unstructured quads (fsr-dance-pad's
+    breadboard platform, face 118, at diameter/100; at the default size the chamfers are
+    under FEATURE sizes and already features).  Where the ties pair up into chamfers,
+    each a straight curve under MAX_SPAN sizes with a tie at either end turning the same
+    way, and the pairs are exactly as many as the quarters missing, each chamfer is one
+    corner in its middle: the same in a mirrored copy, no pose picks an end."""
+    short, helping = tie_shortfall(li, loop)
+    if not helping or len(helping) == abs(short):
+        return []
+    held = {si for f in features for si in f.joints} | {f.pivot_segment for f in features}
+    ties = set(helping)
+    pairs = [k for k in sorted(ties) if (k + 1) % len(loop) in ties
+             and getattr(loop[k], "sweep", 0.0) == 0.0 and loop[k].length < MAX_SPAN * size
+             and not {k, (k + 1) % len(loop)} & held]
+    used = [j for k in pairs for j in (k, (k + 1) % len(loop))]
+    if len(pairs) != abs(short) or len(set(used)) != len(used) or set(used) != ties:
+        return []
+    turns = {t[2]: t for t in _turns(loop) if t[3] == "joint"}
+    total = float(loop_offsets(loop)[-1])
+    out = []
+    for k in pairs:
+        feature = _feature(li, loop, [turns[k], turns[(k + 1) % len(loop)]], total, size)
         if feature is not None:
             out.append(feature)
     return out
