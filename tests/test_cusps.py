@@ -134,3 +134,27 @@ def test_only_the_tips_own_corner_of_a_tip_quad_is_excused(size):
     assert result.structured_share == 1.0, result.problem
     assert result.quality["min_scaled_jacobian"] > 0.5
     assert result.quality["irregular_vertices"] == 0
+
+
+def test_a_mesh_whose_only_poor_quads_sit_at_tips_is_fair_but_at_tips():
+    """What lets the pipeline take a finer layout all in blocks without finishing the
+    first one (pipeline._best_layout): the corpus's plate with two tangent horns at
+    diameter/100 spent 11 s finishing a first layout that lost.  Its mesh is unfair by
+    the tips alone; a mesh with no tip is never excused."""
+    from conftest import REPO
+
+    from quadcnn_wb.core.input.load import load_domain
+    from quadcnn_wb.core.rounds import fair_but_at_tips, mesh_key
+
+    horns = load_domain(REPO / "tests" / "corpus" / "blend_horn_plate.brep")
+    size = diameter(horns) / 100
+    result = mesh_domain(horns, size)
+    assert result.structured_share == 1.0
+    assert not mesh_key(result.mesh)[0]  # a tip quad below FAIR_JACOBIAN
+    assert fair_but_at_tips(result.mesh, result.reference.mesh, size)
+
+    # No tip: nothing to excuse, whatever the worst element (the rule is for tips only).
+    square = domain_from_json({"loops": [[{"line": [[0, 0], [1, 0]]}, {"line": [[1, 0], [1, 1]]},
+                                          {"line": [[1, 1], [0, 1]]}, {"line": [[0, 1], [0, 0]]}]]})
+    result = mesh_domain(square)
+    assert not fair_but_at_tips(result.mesh, result.reference.mesh, result.size)

@@ -44,6 +44,7 @@ from .rounds import (
     LeavesFreeFaces,
     PoorMesh,
     blocks_and_mesh,
+    fair_but_at_tips,
     free_face_problem,
     mesh_key,
 )
@@ -212,6 +213,7 @@ def _best_layout(domain, size, nodes, method, smoothing, learned_streamlines, se
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
     fair, share = mesh_key(finer.mesh)[:2]
+    fair = fair or (share >= 1.0 and fair_but_at_tips(finer.mesh, finer.reference.mesh, size))
     if result is None and fair and share >= GOOD_ENOUGH:  # hardly anything left to beat
         finer.timings["other_background"] = spent
         finer.timings["total"] += spent
