@@ -60,7 +60,10 @@ class MeshWalker:
 
     def barycentric(self, tri: np.ndarray, p: np.ndarray) -> np.ndarray:
         uv = np.einsum("nij,nj->ni", self.inverse[tri], p - self.origin[tri])
-        return np.column_stack([1.0 - uv.sum(axis=1), uv])
+        out = np.empty((len(uv), 3))  # (filled in place: column_stack costs more than the
+        out[:, 0] = 1.0 - uv.sum(axis=1)  # arithmetic on a walk's few points)
+        out[:, 1:] = uv
+        return out
 
     def locate(self, tri: np.ndarray, p: np.ndarray):
         """Walk from ``tri`` to the triangle holding each point (within INSIDE_TOL).
@@ -84,8 +87,10 @@ class MeshWalker:
             edge = worst[~inside]
             nxt = self.neighbours[tri[moving], edge]
             out = nxt < 0
-            exit_edge[moving[out]] = np.column_stack([tri[moving[out]], edge[out]])
-            tri[moving[out]] = -1
+            if out.any():
+                exit_edge[moving[out], 0] = tri[moving[out]]
+                exit_edge[moving[out], 1] = edge[out]
+                tri[moving[out]] = -1
             tri[moving[~out]] = nxt[~out]
             active = moving[~out]
         tri[active] = -1  # lost (should not happen for short steps)

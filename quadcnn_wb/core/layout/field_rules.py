@@ -53,7 +53,10 @@ def nearest_arm(theta: np.ndarray, d: np.ndarray) -> np.ndarray:
     a = np.arctan2(d[:, 1], d[:, 0])
     k = np.rint((a - theta) / (np.pi / 2))
     phi = theta + k * (np.pi / 2)
-    return np.column_stack([np.cos(phi), np.sin(phi)])
+    out = np.empty((len(phi), 2))
+    out[:, 0] = np.cos(phi)
+    out[:, 1] = np.sin(phi)
+    return out
 
 
 # ----------------------------------------------------------------------------------------
