@@ -37,6 +37,8 @@ def test_a_folder_is_meshed_file_by_file_and_compared_with_an_earlier_run(tmp_pa
         ("broken", "default"), ("broken", "d100")}
     good = [r for r in written if r["name"] == "l_shape"]
     assert all(r["structured_share"] == 1.0 and r["quads"] > 0 for r in good)
+    # An L-shape's quads are about the size asked for: none over twice it, none under.
+    assert all(1.0 <= r["longest_edge"] < 2.0 for r in good)
     assert not any("problem" in r for r in good)  # only rows with free faces say why
     assert all("open loop" in r["error"] for r in written if r["name"] == "open")
     assert all(r["error"] for r in written if r["name"] == "broken")  # a corrupt part

@@ -445,3 +445,15 @@ def test_neighbour_means_are_the_plain_average_bit_for_bit():
     used = degree > 0
     assert np.array_equal(means[used], summed[used] / degree[used, None])
     assert np.isnan(means[~used]).all()
+
+
+def test_longest_edge_is_the_longest_side_of_any_quad():
+    from quadcnn_wb.core.mesh.quadmesh import QuadMesh
+    from quadcnn_wb.core.mesh.quality import longest_edge
+
+    # Two quads side by side: 1 x 1 and 3 x 1 (the long one's bottom and top are 3).
+    nodes = np.array([[0, 0], [1, 0], [4, 0], [4, 1], [1, 1], [0, 1]], dtype=float)
+    quads = np.array([[0, 1, 4, 5], [1, 2, 3, 4]])
+    mesh = QuadMesh(nodes=nodes, quads=quads, block_of_quad=np.zeros(2, dtype=int),
+                    boundary=np.ones(6, dtype=bool), edge_nodes=())
+    assert longest_edge(mesh) == pytest.approx(3.0)

@@ -5,14 +5,15 @@
                                           [--poses]
 
 For faces nobody here wrote (a user's own parts, a held-out set of public CAD files): each
-file (.brep .step .stp .iges .igs .json; JSON objects without "loops", such as a manifest
-or a mesh result, are skipped and named) and size runs in a fresh Python with a time limit,
-so a hang or a crash costs that row only.  One line is printed per row and one JSON line
-appended to ROWS (name, size_kind, structured_share, irregular_vertices,
-min_scaled_jacobian, quads, mesh_s, wall_s, or error; problem where some faces are no
-blocks, saying why; mesh_s is timed after one small part meshed untimed in that process,
-wall_s is the whole process); then how many rows are all in blocks per size.  With
---compare, the rows that differ from an earlier ROWS file (share,
+file (.brep .step .stp .iges .igs .json; JSON lists and objects without "loops", such as
+a manifest or a mesh result, are skipped and named) and size runs in a fresh Python with a
+time limit, so a hang or a crash costs that row only.  One line is printed per row and one
+JSON line appended to ROWS (name, size_kind, structured_share, irregular_vertices,
+min_scaled_jacobian, quads, longest_edge: the longest quad edge over the size asked for,
+which shows a block whose counts ignore the size across it; mesh_s, wall_s, or error;
+problem where some faces are no blocks, saying why; mesh_s is timed after one small part
+meshed untimed in that process, wall_s is the whole process); then how many rows are all
+in blocks per size.  With --compare, the rows that differ from an earlier ROWS file (share,
 irregular vertices, errors, or the worst scaled Jacobian by more than 0.01) are listed:
 what a change did to parts the tests do not hold.  With --gmsh, each row also holds gmsh's
 quasi-structured algorithm (Mesh.Algorithm 11) on the same face at the same size (its
@@ -50,6 +51,7 @@ def worker(path: str, kind: str, peer: bool = False, poses: bool = False) -> int
     try:
         from ..core.input.load import load_domain
         from ..core.input.pose import default_size, diameter
+        from ..core.mesh.quality import longest_edge
         from ..core.pipeline import mesh_domain
 
         domain = load_domain(path)
@@ -66,6 +68,7 @@ def worker(path: str, kind: str, peer: bool = False, poses: bool = False) -> int
                 "irregular_vertices": int(result.quality["irregular_vertices"]),
                 "min_scaled_jacobian": float(result.quality["min_scaled_jacobian"]),
                 "quads": int(len(result.mesh.quads)),
+                "longest_edge": round(longest_edge(result.mesh) / size, 3),
             })
             if result.problem:  # which faces are no blocks, and why
                 row["problem"] = result.problem
@@ -166,6 +169,8 @@ def describe(row) -> str:
         return f"error: {row['error'][:70]}"
     text = (f"share {row['structured_share']:.3f} irr {row['irregular_vertices']} "
             f"sj {row['min_scaled_jacobian']:.3f} quads {row['quads']}")
+    if "longest_edge" in row:  # (rows written before it was measured have none)
+        text += f" edge {row['longest_edge']:.1f}"
     if "same_in_poses" in row:
         text += " poses: same" if row["same_in_poses"] else \
             f" poses: differ in {row['poses_differing']}"

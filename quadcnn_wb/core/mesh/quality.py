@@ -37,6 +37,18 @@ def min_scaled_jacobian(mesh) -> float:
     return float(sj.min()) if len(sj) else 0.0
 
 
+def longest_edge(mesh) -> float:
+    """The longest quad edge: what the share, the irregular count and the scaled Jacobian
+    all miss, a block whose counts follow a short side and so ignore the requested size
+    across it (socket_bearing's block over its slot: one segment across, 7.6 sizes long,
+    scaled Jacobian 0.84)."""
+    if not len(mesh.quads):
+        return 0.0
+    corners = mesh.nodes[mesh.quads]
+    edges = np.roll(corners, -1, axis=1) - corners
+    return float(np.hypot(edges[..., 0], edges[..., 1]).max())
+
+
 def structured_share(mesh) -> float:
     """Share of the quads that lie in blocks (block -1: a quad in no block)."""
     return float(np.mean(mesh.block_of_quad >= 0)) if len(mesh.quads) else 0.0
