@@ -346,3 +346,27 @@ def test_a_plate_with_two_small_chamfers_is_all_blocks_in_every_pose(matrix):
     q = result.quality
     assert result.structured_share == 1.0
     assert (q["blocks"], q["irregular_vertices"]) == (1, 2)  # the chamfers' middles
+
+
+def test_fillets_exactly_on_a_rules_bound_read_alike_in_a_moved_copy():
+    """A real face with eight concave fillets turning by exactly 135° (ROUND_SWEEP): the
+    rules compare sizes and turns rounded well above round-off, so the part and its
+    copy moved by 1e4 of its size get the same features (they read them as corners in
+    one copy and curves in the other, 92 blocks against 85)."""
+    from conftest import REPO
+
+    from quadcnn_wb.core.input.load import load_domain
+    from quadcnn_wb.core.input.pose import diameter
+    from quadcnn_wb.core.layout_frame import frame_of, framed_domain, framed_size
+
+    part = load_domain(REPO / "tests" / "corpus" / "fsr_breadboard_frame.brep")
+    moved = domain_from_json(transform_domain(part.to_json(), rotation(0),
+                                              shift=(1e4 * part.size, 1e4 * part.size)))
+
+    def read(domain):
+        frame = frame_of(domain)
+        size = framed_size(diameter(domain) / 100, frame)
+        return summary(boundary_features(framed_domain(domain, frame), size))
+
+    assert read(part) == read(moved)
+    assert read(part).count((2, 315.0)) == 8  # each fillet one concave corner

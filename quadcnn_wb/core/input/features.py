@@ -178,31 +178,36 @@ def _smooth_joints(li, loop, features) -> list:
 def _loop_features(li, loop, size) -> list:
     """One loop's features (see boundary_features), smooth joints aside."""
     out = []
-    reach = FEATURE * size
     total = float(loop_offsets(loop)[-1])
-    turns = [t for t in _turns(loop) if t[3] == "joint" or t[5] - t[4] < reach
-             or (loop[t[2]].radius < ROUND * size and -ROUND_SWEEP <= t[1] < 0.0)
+    turns = [t for t in _turns(loop) if t[3] == "joint" or _sizes(t[5] - t[4], size) < FEATURE
+             or (_sizes(loop[t[2]].radius, size) < ROUND
+                 and -ROUND_SWEEP <= _turn(t[1]) < 0.0)
              or _slot_end(loop, t, size)
-             or (loop[t[2]].radius < CONVEX_ROUND * size and 0.0 < t[1] <= math.pi - CONVEX_MIN)]
+             or (_sizes(loop[t[2]].radius, size) < CONVEX_ROUND
+                 and 0.0 < _turn(t[1]) <= math.pi - CONVEX_MIN)]
     if not turns:
         return out
-    gaps = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
+    lengths = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
+    gaps = [_sizes(gap, size) for gap in lengths]  # in sizes
     # A fillet an element long or more is a feature on its own: the corner beside it
     # is one of the part's, not a detail of the fillet.
     # Not from the other half of a fillet stored as two arcs, though (a crank web's
     # rounded slot corner at diameter/100: two 233° corners an element apart, each
     # with its own streamlines, beside the singular point the fillet put there).
-    long = [t[5] - t[4] >= size and not _slot_end(loop, t, size) for t in turns]
-    gaps = [reach if (long[k] or long[(k + 1) % len(turns)])
+    long = [_sizes(t[5] - t[4], size) >= 1.0 and not _slot_end(loop, t, size) for t in turns]
+    gaps = [FEATURE if (long[k] or long[(k + 1) % len(turns)])
             and not _split_fillet(loop, t, turns[(k + 1) % len(turns)]) else gap
             for k, (t, gap) in enumerate(zip(turns, gaps))]
-    if len(turns) > 1 and max(gaps) < reach:
+    if len(turns) > 1 and max(gaps) < FEATURE:
         return _wavy_loop(li, loop, size)  # the whole loop is one chain
-    first = (int(np.argmax(gaps)) + 1) % len(turns)  # any chain boundary would do
+    # Any chain boundary would do (the chains are the same from each); the widest gap
+    # measured as before keeps the features' order.
+    first = (int(np.argmax([FEATURE * size if g == FEATURE else raw
+                            for g, raw in zip(gaps, lengths)])) + 1) % len(turns)
     chains, chain = [], []
     for k in range(first, first + len(turns)):
         chain.append(turns[k % len(turns)])
-        if gaps[k % len(turns)] >= reach:
+        if gaps[k % len(turns)] >= FEATURE:
             chains.append(chain)
             chain = []
     for chain in chains:
@@ -323,8 +328,25 @@ def _split_fillet(loop, first, second) -> bool:
 def _slot_end(loop, turn, size) -> bool:
     """Whether a turn is a narrow slot's round end: a concave arc of a radius under
     SLOT_END sizes turning by more than ROUND_SWEEP, up to SLOT_SWEEP."""
-    return turn[3] == "curve" and loop[turn[2]].radius < SLOT_END * size \
-        and -SLOT_SWEEP <= turn[1] < -ROUND_SWEEP
+    return turn[3] == "curve" and _sizes(loop[turn[2]].radius, size) < SLOT_END \
+        and -SLOT_SWEEP <= _turn(turn[1]) < -ROUND_SWEEP
+
+
+RULE_DIGITS = 9  # sizes and radians are compared with the rules' bounds at this rounding
+
+
+def _sizes(length: float, size: float) -> float:
+    """A length in element sizes, rounded well above round-off: a part drawn in round
+    numbers puts fillets exactly on the rules' bounds (a 135° fillet against
+    ROUND_SWEEP), where a moved copy's last bit decided (fsr-dance-pad
+    breadboard-platform face 19 at diameter/100: four fillets corners in one copy and
+    curves in the other, 92 blocks against 85)."""
+    return round(length / size, RULE_DIGITS)
+
+
+def _turn(angle: float) -> float:
+    """A turn in radians, rounded as _sizes is."""
+    return round(angle, RULE_DIGITS)
 
 
 def _square_corners(li, loop) -> list:
