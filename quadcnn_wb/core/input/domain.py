@@ -269,8 +269,7 @@ def _check_intersections(loops, eps: float, heal: float) -> None:
                 if _crossing(ci, cj, p, eps):
                     raise DomainError(_pair_message(li, si, lj, sj, f"cross at {_fmt(p)}"))
                 raise DomainError(_pair_message(li, si, lj, sj, f"meet at {_fmt(p)}",
-                                                "touch") + ": the face pinches to no width "
-                                  "there")
+                                                TOUCH) + ": the face pinches to no width there")
 
 
 def _crossing(c1, c2, p, eps: float) -> bool:
@@ -299,11 +298,14 @@ def _shared_vertices(loops, li, si, lj, sj) -> list:
     return out
 
 
-def _pair_message(li, si, lj, sj, what: str, verb: str = "intersect") -> str:
+INTERSECT = ("intersect", "intersects")  # (loops ..., a loop ... itself)
+TOUCH = ("touch", "touches")
+
+
+def _pair_message(li, si, lj, sj, what: str, verbs: tuple = INTERSECT) -> str:
     if li == lj:
-        return f"loop {li} {verb}es itself: segments {si} and {sj} {what}" \
-            if verb == "touch" else f"loop {li} {verb}s itself: segments {si} and {sj} {what}"
-    return (f"loops {li} and {lj} {verb}: loop {li} segment {si} and loop {lj} "
+        return f"loop {li} {verbs[1]} itself: segments {si} and {sj} {what}"
+    return (f"loops {li} and {lj} {verbs[0]}: loop {li} segment {si} and loop {lj} "
             f"segment {sj} {what}")
 
 

@@ -188,22 +188,22 @@ def _loop_features(li, loop, size) -> list:
     if not turns:
         return out
     lengths = [(turns[(k + 1) % len(turns)][4] - t[5]) % total for k, t in enumerate(turns)]
-    gaps = [_sizes(gap, size) for gap in lengths]  # in sizes
     # A fillet an element long or more is a feature on its own: the corner beside it
     # is one of the part's, not a detail of the fillet.
     # Not from the other half of a fillet stored as two arcs, though (a crank web's
     # rounded slot corner at diameter/100: two 233° corners an element apart, each
     # with its own streamlines, beside the singular point the fillet put there).
     long = [_sizes(t[5] - t[4], size) >= 1.0 and not _slot_end(loop, t, size) for t in turns]
-    gaps = [FEATURE if (long[k] or long[(k + 1) % len(turns)])
-            and not _split_fillet(loop, t, turns[(k + 1) % len(turns)]) else gap
-            for k, (t, gap) in enumerate(zip(turns, gaps))]
+    apart = [(long[k] or long[(k + 1) % len(turns)])
+             and not _split_fillet(loop, t, turns[(k + 1) % len(turns)])
+             for k, t in enumerate(turns)]  # a chain ends after turn k whatever the gap
+    gaps = [FEATURE if cut else _sizes(gap, size) for cut, gap in zip(apart, lengths)]
     if len(turns) > 1 and max(gaps) < FEATURE:
         return _wavy_loop(li, loop, size)  # the whole loop is one chain
-    # Any chain boundary would do (the chains are the same from each); the widest gap
-    # measured as before keeps the features' order.
-    first = (int(np.argmax([FEATURE * size if g == FEATURE else raw
-                            for g, raw in zip(gaps, lengths)])) + 1) % len(turns)
+    # Any chain boundary would do (the chains are the same from each); the widest gap,
+    # in lengths, keeps the features in the order they always came in.
+    first = (int(np.argmax([FEATURE * size if cut else gap
+                            for cut, gap in zip(apart, lengths)])) + 1) % len(turns)
     chains, chain = [], []
     for k in range(first, first + len(turns)):
         chain.append(turns[k % len(turns)])
@@ -214,10 +214,10 @@ def _loop_features(li, loop, size) -> list:
         feature = _feature(li, loop, chain, total, size)
         if feature is not None:
             out.append(feature)
-    return out + _chamfers(li, loop, out, size)
+    return out + _chamfers(li, loop, out, size, total)
 
 
-def _chamfers(li, loop, features, size) -> list:
+def _chamfers(li, loop, features, size, total) -> list:
     """Chamfers read as one corner each where the loop's ties leave its turn ambiguous.
 
     A rectangle with two corners chamfered an element wide has four 135° joints, each a
@@ -242,7 +242,6 @@ def _chamfers(li, loop, features, size) -> list:
     if len(pairs) != abs(short) or len(set(used)) != len(used) or set(used) != ties:
         return []
     turns = {t[2]: t for t in _turns(loop) if t[3] == "joint"}
-    total = float(loop_offsets(loop)[-1])
     out = []
     for k in pairs:
         feature = _feature(li, loop, [turns[k], turns[(k + 1) % len(loop)]], total, size)
