@@ -6,8 +6,9 @@ handing it the part in a pose computed from the geometry alone (centroid at the 
 unit diameter, a chosen straight edge along +x with the part above it, a chosen mirror
 image, loops started at a chosen vertex) makes every copy look identical to gmsh.
 Choices are made on keys rounded to KEY_DIGITS, so rounding noise cannot flip them; where
-keys tie the part is symmetric (or nearly) and any choice gives the same mesh up to that
-symmetry.
+keys tie the part is symmetric, or nearly: the image (rounded samples, sorted) that comes
+first is taken, which every copy can tell from the others the same way, however nearly
+symmetric the part.
 """
 
 from __future__ import annotations
@@ -140,67 +141,90 @@ def _canonical_pose(domain) -> Pose:
     circles = [c for loop in domain.loops for c in loop if isinstance(c, Arc) and c.is_full]
     center = area_centroid(domain)
     scale = diameter(domain)
-    rotation = _rotation(domain, center, scale, points, circles)
+    directions, along_edge = _directions(domain, center, scale, points, circles)
     angles = np.linspace(0.0, 2 * math.pi, SAMPLES_PER_CURVE, endpoint=False)
     ring = np.column_stack([np.cos(angles), np.sin(angles)])  # fixed in the turned frame
-    turned = [(points - center) @ rotation.T] + [
-        (np.asarray(c.center) - center) @ rotation.T + c.radius * ring for c in circles]
-    turned = np.concatenate(turned)
-    mirror = np.eye(2)
-    skew = _key(float((turned[:, 0] ** 3).mean()), scale ** 3)
-    if skew < 0 or (skew == 0 and _mirror_image_first(turned / scale)):
-        mirror = np.diag([-1.0, 1.0])  # keeps the chosen edge on +x, the part above it
-    return Pose(center=center, scale=scale, matrix=mirror @ rotation)
+    # The mirror that keeps what the rotation chose: the chosen edge on +x with the part
+    # above it (x -> -x), or the direction to the farthest point along +x (y -> -y).
+    flip = np.array([-1.0, 1.0]) if along_edge else np.array([1.0, -1.0])
+    axis = 0 if along_edge else 1
+    best = None
+    for direction in directions:
+        angle = -math.atan2(direction[1], direction[0])
+        c, s = math.cos(angle), math.sin(angle)
+        rotation = np.array([[c, -s], [s, c]])
+        turned = np.concatenate([(points - center) @ rotation.T] + [
+            (np.asarray(k.center) - center) @ rotation.T + k.radius * ring for k in circles])
+        mirror = np.eye(2)
+        skew = _key(float((turned[:, axis] ** 3).mean()), scale ** 3)
+        if skew < 0 or (skew == 0 and _mirror_image_first(turned / scale, flip)):
+            mirror = np.diag(flip)
+        image = _image(turned * np.diag(mirror) / scale)
+        if best is None or _first(image, best[0]):
+            best = image, mirror @ rotation
+    return Pose(center=center, scale=scale, matrix=best[1])
 
 
 MIRROR_DIGITS = 9  # the samples' grid for telling a nearly symmetric part's images apart
 
 
-def _mirror_image_first(unit_points) -> bool:
-    """For a part symmetric about the y axis to KEY_DIGITS: whether its mirror image comes
-    first, its samples rounded to MIRROR_DIGITS and sorted.  A part symmetric to
-    round-off rounds alike both ways (no mirror); one asymmetric by a little more (held-out
-    0035: 3e-10 of its size) was handed to gmsh as itself in one copy and as its mirror
-    image in a mirrored copy, whose numbers then rounded differently at gmsh's own grid
-    (gmsh_geometry.UNIT_DIGITS): other triangles.  Both copies compare the same two
-    images, so both pick the same one."""
+def _image(unit_points) -> np.ndarray:
+    """The samples rounded to MIRROR_DIGITS, sorted by y then x: what two poses of a part
+    are compared by."""
     given = np.round(unit_points, MIRROR_DIGITS) + 0.0
-    mirrored = given * np.array([-1.0, 1.0]) + 0.0
-    a = given[np.lexsort((given[:, 0], given[:, 1]))]
-    b = mirrored[np.lexsort((mirrored[:, 0], mirrored[:, 1]))]
+    return given[np.lexsort((given[:, 0], given[:, 1]))]
+
+
+def _first(a, b) -> bool:
+    """Whether image ``a`` comes before image ``b`` (the first sample that differs, by y
+    then x)."""
     differ = np.nonzero((a != b).any(axis=1))[0]
     if not len(differ):
         return False
     k = int(differ[0])
-    return (b[k, 1], b[k, 0]) < (a[k, 1], a[k, 0])
+    return (a[k, 1], a[k, 0]) < (b[k, 1], b[k, 0])
 
 
-def _rotation(domain, center, scale, points, circles) -> np.ndarray:
-    """Turn the chosen straight edge (domain on its left) to +x.
+def _mirror_image_first(unit_points, flip) -> bool:
+    """For a part symmetric about the chosen axis to KEY_DIGITS: whether its mirror image
+    (``flip``) comes first (_image, _first).  A part symmetric to round-off rounds alike
+    both ways (no mirror); one asymmetric by a little more (held-out 0035: 3e-10 of its
+    size) was handed to gmsh as itself in one copy and as its mirror image in a mirrored
+    copy, whose numbers then rounded differently at gmsh's own grid
+    (gmsh_geometry.UNIT_DIGITS): other triangles.  Both copies compare the same two
+    images, so both pick the same one."""
+    return _first(_image(unit_points * flip), _image(unit_points))
 
-    The edge: the longest; ties go to the one farther from the centroid, then to the one
-    whose start is farther; without straight edges, the direction from the centroid to
-    the farthest sample (or to the farthest circle's centre) serves.
+
+def _directions(domain, center, scale, points, circles) -> tuple:
+    """(the directions that may be turned to +x, whether they are straight edges).
+
+    The chosen straight edge (domain on its left): the longest, ties going to the one
+    farther from the centroid; edges still tied are all candidates, and the pose whose
+    image comes first takes it (_canonical_pose).  A tie once went to the edge whose
+    start was farther, which a mirror reverses: a part symmetric but for 1e-5 of its
+    size (held-out sensor-assembly f165) had its mirrored copy turned by the other edge
+    of the pair, so gmsh got the other image (other triangles, 22 blocks against 17).
+    Without straight edges: the directions from the centroid to the farthest samples
+    (or to the farthest circle's centre).
     """
-    best_key, direction = None, None
+    best_key, directions = None, []
     for loop in domain.loops:
         for curve in loop:
             if not isinstance(curve, Line):
                 continue
             mid = 0.5 * (curve.p0 + curve.p1)
-            key = (_key(curve.length, scale), _key(float(np.hypot(*(mid - center))), scale),
-                   _key(float(np.hypot(*(curve.p0 - center))), scale))
+            key = (_key(curve.length, scale), _key(float(np.hypot(*(mid - center))), scale))
             if best_key is None or key > best_key:
-                best_key, direction = key, curve.p1 - curve.p0
-    if direction is None:
-        if len(points):
-            far = np.hypot(*(points - center).T)
-            direction = points[int(np.argmax(np.round(far / scale, KEY_DIGITS)))] - center
-        else:
-            direction = _towards_a_circle(circles, center, scale)
-    angle = -math.atan2(direction[1], direction[0])
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s], [s, c]])
+                best_key, directions = key, []
+            if key == best_key:
+                directions.append(curve.p1 - curve.p0)
+    if best_key is not None:
+        return directions, True
+    if len(points):
+        far = np.round(np.hypot(*(points - center).T) / scale, KEY_DIGITS)
+        return [points[k] - center for k in np.nonzero(far == far.max())[0]], False
+    return [_towards_a_circle(circles, center, scale)], False
 
 
 def _towards_a_circle(circles, center, scale) -> np.ndarray:
