@@ -2,7 +2,8 @@
 block: a short boundary arc beside a trace's end takes no segment, so the strip it
 bounds collapses; a six-cornered face is cut in two between opposite corners; as the last
 resort, faces of more corners or with reflex ones are split round a centre; a lens takes
-its two sharpest bends as corners."""
+its two sharpest bends as corners, and of bends tied for that, the pair that balances its
+sides."""
 
 from __future__ import annotations
 
@@ -190,3 +191,27 @@ def test_the_share_of_the_area_in_blocks_is_what_the_free_faces_leave():
     whole = build_partition(plate, [], 1.0)
     assert whole.free_faces and not whole.blocks
     assert block_area_share(whole, plate.area) == pytest.approx(0.0, abs=1e-12)
+
+
+def _clamp_end():
+    """A crescent: an arc from (0, 8) back to (0, 0) bowing in to x = 3, and round it
+    a polyline whose four bends all turn by 45°, two at each end."""
+    return domain_from_json({"loops": [[
+        {"line": [[0, 0], [2, 0]]}, {"line": [[2, 0], [4, 2]]}, {"line": [[4, 2], [4, 6]]},
+        {"line": [[4, 6], [2, 8]]}, {"line": [[2, 8], [0, 8]]},
+        {"arc": [[0, 8], [3, 4], [0, 0]]}]]})
+
+
+def test_of_tied_bends_a_two_cornered_face_takes_the_pair_that_balances_its_sides():
+    # Four bends of exactly 45° tie for the two corners the crescent lacks (held-out
+    # fsr-dance-pad sensor-assembly f343, a C-shaped clamp: eight such chamfer corners,
+    # no block at either size, 18 and 46 irregular vertices from gmsh).  The tie left the
+    # face free; the pair whose block has its opposite sides nearest in length is the
+    # two bends next to the tips (sides 2 and 2, 9.7 and the arc's 9.9), the ends a
+    # clamp's band has.
+    partition = build_partition(_clamp_end(), [], 1.0)
+    assert len(partition.blocks) == 1 and not partition.free_faces
+    corners = sorted(map(tuple, partition.vertices[list(partition.blocks[0].corners)]
+                         .round(9)))
+    assert corners == [(0.0, 0.0), (0.0, 8.0), (2.0, 0.0), (2.0, 8.0)]
+

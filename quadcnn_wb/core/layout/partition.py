@@ -18,6 +18,7 @@ itself (a zero-length edge, a walk that never closes) is a PartitionError.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
@@ -804,34 +805,51 @@ def _lobes(halves, places, h) -> list:
     return lobes
 
 
-def _with_fourth_corner(turns, corner_at):
-    """A three-cornered face whose sides bend somewhere by PROMOTED_TURN or more gets its
-    fourth corner at the sharpest bend (a chamfer's end at a spike's tip, a polyline's
-    kink): one block, whose quads there meet at the boundary's own angle as gmsh's do,
-    instead of three blocks squeezed into the face round an extra irregular vertex.  A tie
-    between two bends is left to the split, so that no pose decides it."""
+def _with_more_corners(turns, corner_at, lengths):
+    """A face of two or three corners whose sides bend somewhere by PROMOTED_TURN or more
+    at enough places gets its missing corners at the sharpest bends: one block, where
+    the face is no block at all.  Three corners: a chamfer's end at a spike's tip, a
+    polyline's kink, where the quads then meet at the boundary's own angle as gmsh's do,
+    instead of three blocks squeezed into the face round an extra irregular vertex.  Two:
+    a lens (a separatrix hugging the boundary from one singular point to the next, past a
+    flat between two scallops).  Where bends tie for the last place taken (a C-shaped
+    clamp's eight 135° chamfer corners, its two tips the face's corners), the choice
+    among them whose block has its opposite sides nearest in length is taken: the
+    clamp's ends are the flats from each tip to the next chamfer, not the top's
+    chamfers, whose block would pair a side of 25 with one of 80.  ``lengths``: of each
+    half-edge of the face (the one ending at position k).  A tie in that too leaves the
+    face as it is, so that no pose decides it."""
+    missing = 4 - len(corner_at)
     rest = np.setdiff1d(np.arange(len(turns)), corner_at)
     rest = rest[turns[rest] >= PROMOTED_TURN]
-    if not len(rest):
-        return corner_at
-    top = rest[turns[rest] >= turns[rest].max() - TURN_TIE]
-    return np.sort(np.append(corner_at, top[0])) if len(top) == 1 else corner_at
-
-
-def _with_two_more_corners(turns, corner_at):
-    """A two-cornered face (a lens: a separatrix hugging the boundary from one singular
-    point to the next, past a flat between two scallops) whose sides bend somewhere by
-    PROMOTED_TURN or more at two places gets its third and fourth corners at the two
-    sharpest bends: one block, where the lens is no block at all.  A tie for the second
-    place leaves the face as it is, so that no pose decides it."""
-    rest = np.setdiff1d(np.arange(len(turns)), corner_at)
-    rest = rest[turns[rest] >= PROMOTED_TURN]
-    if len(rest) < 2:
+    if len(rest) < missing:
         return corner_at
     ranked = rest[np.argsort(-turns[rest], kind="stable")]
-    if len(ranked) > 2 and turns[ranked[1]] - turns[ranked[2]] <= TURN_TIE:
+    last = turns[ranked[missing - 1]]
+    sure = [int(k) for k in ranked if turns[k] - last > TURN_TIE]
+    tied = [int(k) for k in ranked if abs(turns[k] - last) <= TURN_TIE]
+    choices = {tuple(sorted(sure + list(pick)))
+               for pick in itertools.combinations(tied, missing - len(sure))}
+    scored = sorted((_imbalance(np.sort(np.concatenate([corner_at, choice])), lengths),
+                     choice) for choice in choices)
+    if len(scored) > 1 and scored[1][0] - scored[0][0] <= BALANCE_TIE:
         return corner_at
-    return np.sort(np.concatenate([corner_at, ranked[:2]]))
+    return np.sort(np.concatenate([corner_at, scored[0][1]])).astype(int)
+
+
+BALANCE_TIE = 1e-6  # imbalances this close are a tie
+
+
+def _imbalance(corner_at, lengths) -> float:
+    """How far a four-cornered face's opposite sides are from equal lengths: the sum over
+    both pairs of |a - b| / (a + b), rounded so that round-off cannot order two pairs.
+    Corner k sits at the head of half-edge k; side s runs from corner s to corner s + 1."""
+    cum = np.concatenate([[0.0], np.cumsum(lengths)])
+    total = cum[-1]
+    sides = [(cum[corner_at[(s + 1) % 4] + 1] - cum[corner_at[s] + 1]) % total
+             for s in range(4)]
+    return round(sum(abs(sides[s] - sides[s + 2]) / (sides[s] + sides[s + 2])
+                     for s in range(2)), 9)
 
 
 def corners_instead_of_4(n: int) -> str:
@@ -871,10 +889,9 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
             raise PartitionError(f"a block turns back by {-math.degrees(turns[k]):.0f}° near "
                                  f"{fmt(vertices[head(cycle[k])])}: not a four-sided block")
         corner_at = np.nonzero(reflex | (turns > CORNER_TURN))[0]
-    elif len(corner_at) == 3:
-        corner_at = _with_fourth_corner(turns, corner_at)
-    elif len(corner_at) == 2:
-        corner_at = _with_two_more_corners(turns, corner_at)
+    elif len(corner_at) in (2, 3):
+        lengths = np.array([edges[half[c][0]].length for c in cycle])
+        corner_at = _with_more_corners(turns, corner_at, lengths)
     if star and len(corner_at) >= 6 and len(set(head(c) for c in cycle)) < len(cycle):
         raise PartitionError("a block touches itself: not a four-sided block")
     if not reflex.any() and len(corner_at) not in corner_counts:
