@@ -267,9 +267,13 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
             loops_of.extend([li] * len(ids))
             segs_of.extend([si] * len(ids))
             params.extend(t)
-            tangents.extend(np.atleast_2d(curve.tangent(t)))
+            along = np.atleast_2d(curve.tangent(t))
             if len(loop) > 1 or not getattr(curve, "is_full", False):
                 angle = interior_angle(loop[si - 1], curve)
+                if not is_corner(angle) and len(t) and t[0] == 0.0:
+                    along[0] = _joint_tangent(loop[si - 1], curve)
+            tangents.extend(along)
+            if len(loop) > 1 or not getattr(curve, "is_full", False):
                 if is_corner(angle):
                     corner_nodes.append(int(ids[0]))
                     corner_angles.append(angle)
@@ -358,6 +362,16 @@ def with_features(mesh: BackgroundMesh, domain: Domain, features) -> BackgroundM
         corner_tangents_in=np.array([corners[k][2] for k in order],
                                     dtype=float).reshape(-1, 2),
         flat_joints=frozenset(flat), feature_corners=frozenset(inside_curves))
+
+
+def _joint_tangent(before, after) -> np.ndarray:
+    """The tangent at a joint that is no corner: the mean of the two curves' (which
+    differ by under CORNER_MIN_TURN).  The leaving curve's alone depends on which way
+    the loop runs: a mirrored copy of held-out sensor-assembly f164 had every such
+    joint's tangent from the other curve, 3e-7 rad apart, and at diameter/100 its field
+    had a pair of singular points more (51 blocks against 55)."""
+    mean = np.asarray(before.tangent(1.0), float) + np.asarray(after.tangent(0.0), float)
+    return mean / np.hypot(*mean)
 
 
 def _counter_clockwise(coords, triangles):
