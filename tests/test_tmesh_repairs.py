@@ -215,3 +215,27 @@ def test_of_tied_bends_a_two_cornered_face_takes_the_pair_that_balances_its_side
                          .round(9)))
     assert corners == [(0.0, 0.0), (0.0, 8.0), (2.0, 0.0), (2.0, 8.0)]
 
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_an_outline_that_leaves_a_vertex_the_way_it_came_turns_as_its_far_ends_say(
+        mirrored):
+    # A line running on along a boundary's flat and then parting from it (held-out
+    # sensor-assembly f89: lines from a slot's end along its flat top): the face between
+    # turns by exactly pi or -pi there, and round-off chose which, so one of two such
+    # faces was a block and its mirror image's was not.  The far ends decide: a face
+    # squeezed between the two (the boundary bends away from the line on the face's
+    # side) has a corner of no angle (pi); one the other side turns back (-pi).
+    from quadcnn_wb.core.layout.partition import _turn_back
+
+    line = np.array([[2.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # arriving at the vertex
+    away = np.array([[0.0, 0.0], [0.5, 0.0], [1.0, -0.3], [1.5, -1.0]])
+    back = away * [1.0, -1.0]
+    flip = np.array([-1.0, 1.0])
+    for leaving, turn in ((away, np.pi), (back, -np.pi)):
+        if mirrored:  # the mirror image runs round the face the other way
+            arriving, leaving = (leaving * flip)[::-1], (line * flip)[::-1]
+        else:
+            arriving = line
+        d_in = arriving[-1] - arriving[-2]
+        assert _turn_back(arriving, leaving, d_in / np.hypot(*d_in)) == turn

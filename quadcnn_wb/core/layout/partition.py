@@ -870,6 +870,8 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
         d_in = -_direction(pin[::-1], min(reach, edges[e_in].length / 3))
         d_out = _direction(pout, min(reach, edges[e_out].length / 3))
         turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
+        if math.pi - abs(turn) <= TURN_TIE:
+            turn = _turn_back(pin, pout, d_in)
         if head(hid) in vertex_turns and edges[e_in].is_boundary and edges[e_out].is_boundary:
             turn = vertex_turns[head(hid)]  # a feature corner, the boundary both sides
         turns.append(turn)
@@ -914,6 +916,18 @@ def _block_of(cycle, half, edges, vertices, h, head, vertex_turns, corner_counts
         sides.append([half[cycle[i]] for i in idx])
         corners.append(head(cycle[corner_at[s]]))
     return corners, sides, tuple(int(j) for j in np.nonzero(reflex[corner_at])[0])
+
+
+def _turn_back(arriving, leaving, d_in) -> float:
+    """The turn, pi or -pi, where a face's outline leaves a vertex the way it came (a
+    line that runs on along a boundary's flat and then parts from it): pi (a corner of
+    no angle) where the leaving edge lies on the face's side, the left, of the arriving
+    one, as their far ends show; -pi (turns back) otherwise.  Round-off gave the sign:
+    held-out sensor-assembly f89 had one of its two such faces a block and the other
+    not, and its mirror image both free."""
+    gap = np.asarray(leaving[-1], float) - np.asarray(arriving[0], float)
+    side = d_in[0] * gap[1] - d_in[1] * gap[0]
+    return math.pi if side > 0.0 else -math.pi
 
 
 def _star_face(turns, corner_at, places) -> bool:
