@@ -370,3 +370,18 @@ def test_fillets_exactly_on_a_rules_bound_read_alike_in_a_moved_copy():
 
     assert read(part) == read(moved)
     assert read(part).count((2, 315.0)) == 8  # each fillet one concave corner
+
+
+def test_a_stretch_holds_its_end_joint_however_the_loop_starts():
+    # A stretch that wraps past the loop's start and ends on a joint: measured from the
+    # stretch's start modulo the loop, that joint came out an ulp past the end (held-out
+    # Prusa MINI minda-holder f103: a 270° corner left out of its notch's feature in the
+    # mirrored copy only, and a corner source more).  These numbers do that.
+    from quadcnn_wb.core.input.features import _within
+
+    total, start, at = 0.9192870000000001, 0.7661888208304218, 0.08680453071432968
+    end = at + total
+    assert (at - start) % total > end - start  # the old test's answer: outside
+    assert _within(at, start, end, total)
+    assert _within(start, start, end, total) and _within(start - 1e-15, start, end, total)
+    assert not _within(at + 1e-6, start, end, total)
