@@ -268,18 +268,18 @@ def _assemble(domain: Domain, coords, triangles, curve_nodes, h,
             segs_of.extend([si] * len(ids))
             params.extend(t)
             along = np.atleast_2d(curve.tangent(t))
+            angle = None  # a lone circle has no joint
             if len(loop) > 1 or not getattr(curve, "is_full", False):
                 angle = interior_angle(loop[si - 1], curve)
                 if not is_corner(angle) and len(t) and t[0] == 0.0:
                     along[0] = _joint_tangent(loop[si - 1], curve)
             tangents.extend(along)
-            if len(loop) > 1 or not getattr(curve, "is_full", False):
-                if is_corner(angle):
-                    corner_nodes.append(int(ids[0]))
-                    corner_angles.append(angle)
-                    corner_in.append(loop[si - 1].tangent(1.0))
-                    if (li, si) in ties:
-                        odd_nodes.add(int(ids[0]))
+            if angle is not None and is_corner(angle):
+                corner_nodes.append(int(ids[0]))
+                corner_angles.append(angle)
+                corner_in.append(loop[si - 1].tangent(1.0))
+                if (li, si) in ties:
+                    odd_nodes.add(int(ids[0]))
     triangles = _counter_clockwise(coords, np.asarray(triangles, dtype=np.int64))
     return BackgroundMesh(
         nodes=coords, triangles=triangles, boundary_nodes=np.array(boundary, dtype=np.int64),
