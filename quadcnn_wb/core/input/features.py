@@ -214,10 +214,10 @@ def _loop_features(li, loop, size) -> list:
         feature = _feature(li, loop, chain, total, size)
         if feature is not None:
             out.append(feature)
-    return out + _chamfers(li, loop, out, size, total)
+    return out + _chamfers(li, loop, out, size, total, turns)
 
 
-def _chamfers(li, loop, features, size, total) -> list:
+def _chamfers(li, loop, features, size, total, turns) -> list:
     """Chamfers read as one corner each where the loop's ties leave its turn ambiguous.
 
     A rectangle with two corners chamfered an element wide has four 135° joints, each a
@@ -229,7 +229,8 @@ def _chamfers(li, loop, features, size, total) -> list:
     under FEATURE sizes and already features).  Where the ties pair up into chamfers,
     each a straight curve under MAX_SPAN sizes with a tie at either end turning the same
     way, and the pairs are exactly as many as the quarters missing, each chamfer is one
-    corner in its middle: the same in a mirrored copy, no pose picks an end."""
+    corner in its middle: the same in a mirrored copy, no pose picks an end.
+    ``turns``: the loop's turns as _loop_features kept them (every joint among them)."""
     short, helping = tie_shortfall(li, loop)
     if not helping or len(helping) == abs(short):
         return []
@@ -241,10 +242,10 @@ def _chamfers(li, loop, features, size, total) -> list:
     used = [j for k in pairs for j in (k, (k + 1) % len(loop))]
     if len(pairs) != abs(short) or len(set(used)) != len(used) or set(used) != ties:
         return []
-    turns = {t[2]: t for t in _turns(loop) if t[3] == "joint"}
+    joints = {t[2]: t for t in turns if t[3] == "joint"}
     out = []
     for k in pairs:
-        feature = _feature(li, loop, [turns[k], turns[(k + 1) % len(loop)]], total, size)
+        feature = _feature(li, loop, [joints[k], joints[(k + 1) % len(loop)]], total, size)
         if feature is not None:
             out.append(feature)
     return out
