@@ -31,8 +31,8 @@ def _unit_loops(domain: Domain, pose: Pose, splits=None):
     Each loop is a list of (loop index, segment index, start, middle or None, end) with the
     domain on the left in the pose (a mirrored pose reverses the loops), starting at its
     lowest-then-leftmost vertex; holes sorted by that vertex.  Full circles are
-    (loop index, centre, radius).  ``splits``: {(loop, segment): parameter} of curves cut
-    in two there (each half is one entry, with the same indices).
+    (loop index, centre, radius).  ``splits``: {(loop, segment): parameters, ascending}
+    of curves cut there (each piece is one entry, with the same indices).
     """
     splits = splits or {}
     loops = []
@@ -43,9 +43,8 @@ def _unit_loops(domain: Domain, pose: Pose, splits=None):
             continue
         pieces = []
         for si, c in enumerate(loop):
-            cut = splits.get((li, si))
-            stretches = ((0.0, 1.0),) if cut is None else ((0.0, cut), (cut, 1.0))
-            for t0, t1 in stretches:
+            ends = (0.0, *splits.get((li, si), ()), 1.0)
+            for t0, t1 in zip(ends[:-1], ends[1:]):
                 mid = unit(pose.to_unit(c.point(0.5 * (t0 + t1)))) if isinstance(c, Arc) \
                     else None
                 pieces.append((li, si, unit(pose.to_unit(c.point(t0))), mid,
@@ -66,8 +65,8 @@ def build_geometry(domain: Domain, pose: Pose, splits=None) -> dict:
     """OCC curves for every domain curve, in unit coordinates; returns tag -> (loop, seg).
 
     Into the current gmsh model (inside a gmsh_session); the caller meshes it.
-    ``splits``: {(loop, segment): parameter} where a curve gets a vertex (and so a mesh
-    node) of its own; both halves map to the curve's (loop, seg)."""
+    ``splits``: {(loop, segment): parameters, ascending} where a curve gets vertices (and
+    so mesh nodes) of its own; every piece maps to the curve's (loop, seg)."""
     occ = gmsh.model.occ
     curve_tags = {}
     loop_tags = []

@@ -169,9 +169,13 @@ def background_mesh(domain: Domain, nodes: int = 2048, threads: int = 1,
     size = default_size(domain) if feature_size is None else feature_size
     features = boundary_features(domain, size)
     # A concave feature's corner inside a curve gets a vertex there: the one node that
-    # stands for it, the same in a mirrored copy (the nearest of two could not be).
-    splits = {(f.loop, f.pivot_segment): f.pivot_param for f in features
-              if f.angle is not None and f.pivot_param > 0.0}
+    # stands for it, the same in a mirrored copy (the nearest of two could not be).  A
+    # wider slot's round end holds two.
+    splits = {}
+    for f in features:
+        if f.angle is not None and f.pivot_param > 0.0:
+            splits.setdefault((f.loop, f.pivot_segment), set()).add(f.pivot_param)
+    splits = {key: tuple(sorted(params)) for key, params in splits.items()}
     # Rounded well above round-off (a moved or turned copy must ask gmsh for the same size).
     # gmsh sees the part as the caller had it, in its canonical pose (core.layout_frame)
     source, source_pose = domain.__dict__.get("_gmsh_source", (domain, pose))
