@@ -83,24 +83,6 @@ def test_a_corner_angle_at_a_tie_is_the_tie_whatever_the_round_off():
     assert corner_quads(math.radians(1.4)) == 1 and nearest_quarters(math.radians(1.4)) == 0
 
 
-def test_a_winding_at_an_opposite_pair_is_the_same_whatever_the_round_off():
-    # Two nodes of a triangle hold opposite values: the change along their edge is pi,
-    # and a copy of the part whose values are 1e-12 off either way must wind alike.
-    from quadcnn_wb.core.field.framefield import triangle_windings
-
-    triangle = np.array([[0, 1, 2]])
-    windings = {int(triangle_windings(np.array([1.0, 1j, complex(-1.0, off)]), triangle)[0])
-                for off in (1e-12, 0.0, -0.0, -1e-12)}
-    assert len(windings) == 1
-    # Two triangles of a square sharing the tied diagonal: z turns once round the square,
-    # so the zero on the diagonal is in exactly one of them (the wrap counted -pi along
-    # the diagonal both ways, and neither held it).
-    square = np.array([[0, 1, 2], [0, 2, 3]])
-    turns = triangle_windings(np.array([1.0, 1j, -1.0, -1j]), square)
-    assert sorted(turns.tolist()) == [0, 1]
-
-
-
 def test_frames_are_unit_and_perpendicular(example_path):
     _, field = field_of(load_domain(example_path))
     f = field.frames

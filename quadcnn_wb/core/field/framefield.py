@@ -162,31 +162,15 @@ def solve_cross_field(mesh: BackgroundMesh, boundary_z: np.ndarray | None = None
 
 
 def triangle_windings(z: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Turns of arg z around each triangle (each edge's change wrapped to (-pi, pi]).
-
-    Where two nodes of a triangle hold opposite values (beside a 135° chamfer's corner,
-    whose node splits the difference between its sides' opposite values), the change
-    along their edge is pi to round-off, and the wrap let its last bit decide whether the
-    triangle held a zero (Prusa i3 heatbed face, moved by 1e4 of its size: z off by
-    6e-11, a valence-3 point for a valence-5 one, 85 blocks against 81; an x-end-idler
-    face a valence-3 point more); an exact pi was -pi both ways, so neither triangle on
-    the edge held the zero it carries, and the windings did not add up to the boundary's.
-    A change within TIE_TOL of pi is a tie: +pi from the lower-numbered node (every copy
-    of the part has the same background nodes, numbered alike), so the triangle on the
-    edge's other side, walking it the other way, counts -pi, and the zero is in exactly
-    one of them."""
+    """Turns of arg z around each triangle (each edge's change wrapped to (-pi, pi])."""
     ang = np.angle(z)
     total = np.zeros(len(triangles))
     for k in range(3):
-        a, b = triangles[:, k], triangles[:, (k + 1) % 3]
-        d = (ang[b] - ang[a] + np.pi) % (2 * np.pi) - np.pi
-        tie = np.pi - np.abs(d) < TIE_TOL
-        d[tie] = np.where(a[tie] < b[tie], np.pi, -np.pi)
-        total += d
+        d = ang[triangles[:, (k + 1) % 3]] - ang[triangles[:, k]]
+        total += (d + np.pi) % (2 * np.pi) - np.pi
     return np.rint(total / (2 * np.pi)).astype(int)
 
 
-TIE_TOL = 1e-7  # radians: a change this close to half a turn is one (copies differ by 1e-9)
 POSE_DIGITS = 12  # unit-pose coordinates and tangents are rounded to this many decimals
 
 

@@ -77,7 +77,7 @@ from .small_holes import field_direction, is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
-ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's end: SLOT_END, WIDE_SLOT_END)
+ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle: two corners)
 SLOT_END = 1.0  # element sizes: ... unless its radius is under this (a narrow slot's end)
 SLOT_SWEEP = math.radians(200)  # ... turning at most this
 WIDE_SLOT_END = 1.5  # element sizes: from SLOT_END up to this radius, two corners
