@@ -77,7 +77,7 @@ from .small_holes import field_direction, is_quartered
 
 FEATURE = 0.5  # element sizes: turns closer together than this are one feature
 ROUND = 2.5  # element sizes: a concave fillet of a smaller radius is read as a corner ...
-ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's half circle: two corners)
+ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's end: SLOT_END, WIDE_SLOT_END)
 SLOT_END = 1.0  # element sizes: ... unless its radius is under this (a narrow slot's end)
 SLOT_SWEEP = math.radians(200)  # ... turning at most this
 WIDE_SLOT_END = 1.5  # element sizes: from SLOT_END up to this radius, two corners
@@ -247,11 +247,9 @@ def _wide_slot_ends(li, loop, features, size) -> list:
     offsets = loop_offsets(loop)
     out = []
     for si, arc in enumerate(loop):
-        sweep = getattr(arc, "sweep", 0.0)
         after = (si + 1) % len(loop)
-        if not sweep or {si, after} & held or si in within \
-                or not SLOT_END <= _sizes(arc.radius, size) < WIDE_SLOT_END \
-                or not -SLOT_SWEEP <= _turn(sweep) < -ROUND_SWEEP:
+        if {si, after} & held or si in within \
+                or not _round_end(arc, size, SLOT_END, WIDE_SLOT_END):
             continue
         joints = (interior_angle(loop[si - 1], arc), interior_angle(arc, loop[after]))
         if any(is_corner(a) and not is_smooth_join(a) for a in joints):
@@ -260,7 +258,7 @@ def _wide_slot_ends(li, loop, features, size) -> list:
         middle = 0.5 * (start + end)
         for lo, hi, param in ((start, middle, 0.25), (middle, end, 0.75)):
             out.append(Feature(li, (), lo, hi, 0.5 * (lo + hi), si, param,
-                               math.pi - 0.5 * sweep,
+                               math.pi - 0.5 * arc.sweep,
                                np.asarray(arc.tangent(param - 0.25), float),
                                np.asarray(arc.tangent(param + 0.25), float)))
     return out
@@ -377,8 +375,15 @@ def _split_fillet(loop, first, second) -> bool:
 def _slot_end(loop, turn, size) -> bool:
     """Whether a turn is a narrow slot's round end: a concave arc of a radius under
     SLOT_END sizes turning by more than ROUND_SWEEP, up to SLOT_SWEEP."""
-    return turn[3] == "curve" and _sizes(loop[turn[2]].radius, size) < SLOT_END \
-        and -SLOT_SWEEP <= _turn(turn[1]) < -ROUND_SWEEP
+    return turn[3] == "curve" and _round_end(loop[turn[2]], size, 0.0, SLOT_END)
+
+
+def _round_end(curve, size, smallest: float, largest: float) -> bool:
+    """Whether a curve is a slot's round end of a radius from ``smallest`` up to
+    ``largest`` sizes: a concave arc turning by more than ROUND_SWEEP, up to SLOT_SWEEP."""
+    sweep = getattr(curve, "sweep", 0.0)
+    return bool(sweep) and smallest <= _sizes(curve.radius, size) < largest \
+        and -SLOT_SWEEP <= _turn(sweep) < -ROUND_SWEEP
 
 
 RULE_DIGITS = 9  # sizes and radians are compared with the rules' bounds at this rounding
