@@ -40,6 +40,12 @@ def test_node_count_within_five_percent(example_path, target):
     [rect(2, 1), circle(0.5, 0.5, 0.01)],  # hole far below the element size
     [circle(0, 0, 1e-6)],  # a 1 µm disk
     [circle(0, 0, 1e5), circle(3e4, 0, 5e4)],  # a 100 km part with an off-centre hole
+    # bolt holes of 3 mm in a grid all over a plate: gmsh spread their sizes everywhere
+    # and jumped from 150 to 4000 nodes
+    [rect(200, 200)] + [circle(20 + 80 * i, 20 + 80 * j, 1.5)
+                        for i in range(3) for j in range(3)],
+    [rect(254, 264)] + [circle(20 + 53.5 * i, 20 + 112 * j, 1.6)
+                        for i in range(5) for j in range(3)],
 ])
 def test_node_count_on_awkward_shapes(loops):
     mesh = background_mesh(domain_from_json({"loops": loops}), nodes=2048)

@@ -332,6 +332,32 @@ def test_a_wider_slots_round_ends_are_two_corners_each(size):
     assert not [f for f in boundary_features(domain, 0.6) if f.angle is not None]
 
 
+@pytest.mark.parametrize("radius, length", [(0.7, 5.2), (1.4, 5.2), (2.5, 2.0)])
+def test_a_slot_shorter_than_a_small_hole_is_a_rectangle(radius, length):
+    # A 47 x 257 plate (default size 6.5) with one slot 1 to 1.3 sizes long end to end:
+    # read as slits or curves, no line reached it and the quads covered it (no block at
+    # all); now each round end is two 270° corners, as a small round hole's square.
+    import math
+
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    plate = [{"line": [[0, 0], [47.37, 0]]}, {"line": [[47.37, 0], [47.37, 257.3]]},
+             {"line": [[47.37, 257.3], [0, 257.3]]}, {"line": [[0, 257.3], [0, 0]]}]
+    x, y0, y1 = 30.2, 97.7 - length / 2, 97.7 + length / 2
+    h = radius / math.sqrt(2)
+    slot = [{"line": [[x + radius, y0], [x + radius, y1]]},
+            {"arc": [[x + radius, y1], [x + h, y1 + h], [x - radius, y1]]},
+            {"line": [[x - radius, y1], [x - radius, y0]]},
+            {"arc": [[x - radius, y0], [x - h, y0 - h], [x + radius, y0]]}]
+    domain = domain_from_json({"loops": [plate, slot]})
+    result = mesh_domain(domain)
+    assert [round(math.degrees(f.angle)) for f in boundary_features(domain, result.size)
+            if f.angle is not None] == [270] * 4
+    assert result.structured_share == 1.0
+    assert result.quality["irregular_vertices"] == result.feature_corners == 4
+    assert result.quality["min_scaled_jacobian"] > 0.9
+
+
 def test_a_fillet_stored_as_two_arcs_is_one_corner():
     # The L's concave corner rounded by two tangent 45° arcs of radius 1.6 and 1.75 sizes,
     # each longer than a size (a crank web's rounded slot corner at diameter/100): a

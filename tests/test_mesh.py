@@ -88,6 +88,26 @@ def test_annulus_gets_a_cut_and_meshes():
     assert result.quality["irregular_vertices"] == 0
 
 
+def test_a_plate_with_bolt_holes_all_over_gets_blocks_at_both_sizes():
+    """Nine 3 mm holes in a grid on a 200 mm plate: the background could not be had
+    (gmsh spread the holes' sizes over the plate) and the part was refused."""
+    from conftest import circle, rect
+
+    from quadcnn_wb.core.input.domain import domain_from_json
+    from quadcnn_wb.core.input.pose import diameter
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    domain = domain_from_json({"loops": [rect(200, 200)] + [
+        circle(20 + 80 * i, 20 + 80 * j, 1.5) for i in range(3) for j in range(3)]})
+    for size in (None, diameter(domain) / 100):
+        result = mesh_domain(domain, size=size)
+        assert result.structured_share == 1.0
+        mesh = result.mesh
+        check_quad_mesh(mesh.nodes, mesh.quads, result.domain.area,
+                        on_boundary_of(result.domain))
+        assert result.quality["min_scaled_jacobian"] > 0.9
+
+
 def test_mesh_exports_read_back(tmp_path):
     result = meshed("plate_hole")
     from quadcnn_wb.core.mesh.export import export

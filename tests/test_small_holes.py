@@ -168,9 +168,11 @@ def _stadium_hole_json(length, radius):
     return {"loops": [outer, slot]}
 
 
-@pytest.mark.parametrize("length, squared", [(1.0, True), (4.0, False)])
-def test_a_hole_with_no_corner_is_squared_only_below_an_element(length, squared):
-    # 0.5 + 2 * 0.75 = 2.5 mm against 4.0 + 1.5 = 5.5 mm long, at 4 mm elements.
+@pytest.mark.parametrize("length, squared", [(1.0, True), (4.0, True), (8.0, False)])
+def test_a_slot_has_four_corners_only_below_one_and_a_half_elements(length, squared):
+    # 1.0 + 2 * 0.75 = 2.5 mm (squared: under an element), 5.5 mm (a rectangle,
+    # input.features.SMALL_SLOT: read with no corner, the layout left it unreached and the
+    # whole plate fell back) and 9.5 mm long, at 4 mm elements.
     domain = domain_from_json(_stadium_hole_json(length, 0.75))
     corners_read = [f for f in boundary_features(domain, SIZE)
                     if f.loop == 1 and f.angle == pytest.approx(1.5 * math.pi)]

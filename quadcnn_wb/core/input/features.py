@@ -44,6 +44,9 @@ turn, or a curve's, is one feature with the sum of its turns:
   quads in blocks, 25 s); as a slot with square ends it needs none.  From
   WIDE_SLOT_END sizes on the field places them well (corpus control_arm's 145° arcs of
   2 sizes read as corners: a worst quad of 0.77 against 0.91).
+- a slot hole shorter than SMALL_SLOT sizes end to end (_is_small_slot) is a rectangle:
+  each end two corners, as a wider slot's, whatever its radius, as a small round hole
+  is a square (input.small_holes).
 A lone corner is never changed, nor a flat chain whose corners are each flat already, nor
 a chain of turns longer than MAX_SPAN sizes (a curve stored as a polyline: see below; one
 fillet's length is bounded by its radius rule), so a part with no such features is read
@@ -81,6 +84,7 @@ ROUND_SWEEP = math.radians(135)  # ... up to this turn (a slot's end: SLOT_END, 
 SLOT_END = 1.0  # element sizes: ... unless its radius is under this (a narrow slot's end)
 SLOT_SWEEP = math.radians(200)  # ... turning at most this
 WIDE_SLOT_END = 1.5  # element sizes: from SLOT_END up to this radius, two corners
+SMALL_SLOT = 1.5  # element sizes: a slot shorter than this end to end is a rectangle
 CONVEX_ROUND = 1.0  # element sizes: so is a convex fillet of a smaller radius
 MAX_SPAN = 3.0  # element sizes: a longer chain of turns is no feature
 JOINT_TOL = 1e-9  # a middle this close (in curve parameter) to a joint is that joint,
@@ -187,8 +191,32 @@ def _smooth_joints(li, loop, features) -> list:
 
 def _loop_features(li, loop, size) -> list:
     """One loop's features (see boundary_features), smooth joints aside."""
+    if _is_small_slot(li, loop, size):
+        return [f for si, arc in enumerate(loop) if getattr(arc, "sweep", 0.0)
+                for f in _end_corners(li, loop, si)]
     features = _chained_features(li, loop, size)
     return features + _wide_slot_ends(li, loop, features, size)
+
+
+def _is_small_slot(li, loop, size) -> bool:
+    """Whether a hole is a slot shorter than SMALL_SLOT sizes end to end: lines and two
+    round ends (_round_end, up to WIDE_SLOT_END), every join smooth.  It is read as a
+    small round hole is, a rectangle at the mesh's scale (each end two corners, as
+    _wide_slot_ends has them).  Read by the other rules (each narrow end one corner,
+    chained with the sides when they are short) a slot of one to 1.3 sizes left a loop
+    the layout could not reach: a plate with one slot 8 x 2.8 mm at its 6.5 mm default
+    size had no block at all (the quads covered the slot).  Longer slots are slits
+    there, with two irregular vertices fewer (corpus bracket_plate's five slots of 2.8
+    sizes: 16 irregular vertices, 26 as rectangles, the same worst quad)."""
+    ends = [c for c in loop if getattr(c, "sweep", 0.0)]
+    if li == 0 or len(ends) != 2 or len(loop) > 4 \
+            or not all(_round_end(c, size, 0.0, WIDE_SLOT_END) for c in ends):
+        return False
+    if not all(is_smooth_join(interior_angle(loop[k - 1], loop[k])) for k in range(len(loop))):
+        return False
+    a, b = ends
+    length = float(np.hypot(*(a.center - b.center))) + a.radius + b.radius
+    return _sizes(length, size) < SMALL_SLOT
 
 
 def _chained_features(li, loop, size) -> list:
@@ -234,13 +262,12 @@ def _chained_features(li, loop, size) -> list:
 
 
 def _wide_slot_ends(li, loop, features, size) -> list:
-    """Two concave corners for each wider slot's round end (see the module docstring):
-    a concave arc of a radius from SLOT_END up to WIDE_SLOT_END sizes turning by more than
-    ROUND_SWEEP, up to SLOT_SWEEP, whose joints are smooth and held by no other feature.
-    Each corner holds half the arc and sits in its middle, a quarter of the arc from
-    either end: the same places whichever way the loop runs.  Held are the joints (a
-    segment's starting one) in a feature or at its pivot, and the curves a pivot lies
-    within: both end joints are asked, so a mirrored copy asks the same."""
+    """Two concave corners (_end_corners) for each wider slot's round end (see the
+    module docstring): a concave arc of a radius from SLOT_END up to WIDE_SLOT_END sizes
+    turning by more than ROUND_SWEEP, up to SLOT_SWEEP, whose joints are smooth and held
+    by no other feature.  Held are the joints (a segment's starting one) in a feature or
+    at its pivot, and the curves a pivot lies within: both end joints are asked, so a
+    mirrored copy asks the same."""
     held = {si for f in features for si in f.joints} \
         | {f.pivot_segment for f in features if f.pivot_param == 0.0}
     within = {f.pivot_segment for f in features if f.pivot_param != 0.0}
@@ -254,14 +281,22 @@ def _wide_slot_ends(li, loop, features, size) -> list:
         joints = (interior_angle(loop[si - 1], arc), interior_angle(arc, loop[after]))
         if any(is_corner(a) and not is_smooth_join(a) for a in joints):
             continue
-        start, end = float(offsets[si]), float(offsets[si + 1])
-        middle = 0.5 * (start + end)
-        for lo, hi, param in ((start, middle, 0.25), (middle, end, 0.75)):
-            out.append(Feature(li, (), lo, hi, 0.5 * (lo + hi), si, param,
-                               math.pi - 0.5 * arc.sweep,
-                               np.asarray(arc.tangent(param - 0.25), float),
-                               np.asarray(arc.tangent(param + 0.25), float)))
+        out += _end_corners(li, loop, si, offsets)
     return out
+
+
+def _end_corners(li, loop, si, offsets=None) -> list:
+    """A slot's round end (curve ``si``) as two concave corners, each holding half the
+    arc and sitting in its middle, a quarter of the arc from either end: the same places
+    whichever way the loop runs."""
+    offsets = loop_offsets(loop) if offsets is None else offsets
+    arc = loop[si]
+    start, end = float(offsets[si]), float(offsets[si + 1])
+    middle = 0.5 * (start + end)
+    return [Feature(li, (), lo, hi, 0.5 * (lo + hi), si, param, math.pi - 0.5 * arc.sweep,
+                    np.asarray(arc.tangent(param - 0.25), float),
+                    np.asarray(arc.tangent(param + 0.25), float))
+            for lo, hi, param in ((start, middle, 0.25), (middle, end, 0.75))]
 
 
 def _chamfers(li, loop, features, size, total, turns) -> list:
