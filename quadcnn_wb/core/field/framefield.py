@@ -249,13 +249,14 @@ def _field_here(mesh: BackgroundMesh) -> FrameField:
 def _zeros(mesh: BackgroundMesh) -> tuple:
     """(z, singular points) on this mesh, in its own coordinates."""
     sharp = _sharp_corners(mesh)
+    edges = boundary_edges(mesh)
     z = solve_cross_field(mesh, boundary_values(mesh, sharp))
-    windings = triangle_windings(z, mesh.triangles, boundary_edges(mesh))
+    windings = triangle_windings(z, mesh.triangles, edges)
     singular = np.nonzero(windings)[0]
     undone = _undone_sharp_corners(mesh, sharp, windings, singular)
     if undone:
         z = solve_cross_field(mesh, boundary_values(mesh, sharp - undone))
-        windings = triangle_windings(z, mesh.triangles, boundary_edges(mesh))
+        windings = triangle_windings(z, mesh.triangles, edges)
         singular = np.nonzero(windings)[0]
     patches = _triangle_patches(mesh.triangles, singular)
     return z, tuple(_singularity(mesh, z, int(t), int(windings[t]), patch)
