@@ -137,9 +137,10 @@ FINE_TOO_SLOW = {"perforated_plate"}
 # corners and the four to spare (nist_ctc04_plate 144 against 140, grabcad_part19 16
 # against 12; gmsh alg. 11 has 387 and 144).
 FINE_EXTRA_IRREGULAR = {"nist_ctc04_plate", "grabcad_part19"}
-# Free faces there too (blend_sawtooth: 0.95 of it in blocks, nist_ctc02_logo_plate 0.994,
-# nist_ctc01_logo_bracket 0.973).
-FINE_PARTLY_BLOCKS = {"blend_sawtooth", "nist_ctc02_logo_plate", "nist_ctc01_logo_bracket"}
+# Free faces there too (blend_sawtooth: 0.62 of it in blocks).  nist_ctc02_logo_plate and
+# nist_ctc01_logo_bracket (0.994 and 0.981) are all blocks on the third background try
+# (pipeline.finest_background_nodes), and perforated_plate too (0.983: 100 s, not here).
+FINE_PARTLY_BLOCKS = {"blend_sawtooth"}
 
 
 @pytest.mark.parametrize("name", [
