@@ -125,7 +125,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     size = default_size(domain) if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
-    finest_nodes = finest_background_nodes(nodes, default_size(domain) / size)
+    finer_than_default = default_size(domain) / size
     # Every copy of the part is meshed in one frame (core.layout_frame) and turned back.
     frame = frame_of(domain)
     framed = framed_domain(domain, frame)
@@ -135,7 +135,7 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
     # holds the part as given, whose curves the exports name.
     unit_size = framed_size(size, frame)
     layout = same_frame(squared_holes(framed, unit_size), framed, domain, frame)
-    result = _best_layout(layout, unit_size, nodes, finest_nodes, method, smoothing,
+    result = _best_layout(layout, unit_size, nodes, finer_than_default, method, smoothing,
                           learned_streamlines, seconds)
     if method == "numerical" and result.structured_share < 1.0:
         result = _with_more_holes_squared(result, framed, domain, frame, unit_size, nodes,
@@ -186,25 +186,25 @@ def _learned_in_frame(learned_streamlines, frame):
 
 
 def finest_background_nodes(nodes: int, finer_than_default: float) -> int:
-    """Background nodes of a third try, for elements finer than the default size
-    (diameter / 40): FINER_BACKGROUND times ``nodes`` and as many more as the elements
-    are finer, so that the background holds about as many nodes per quad as the second
-    try does at the default size; 0 (no third try) where that is under twice the second
-    try's.
+    """Background nodes of the third try: four times the second try's, or, for elements
+    finer than the default size (diameter / 40), as many per quad as the second try has
+    at the default size, whichever is more (32768 and 51200 at diameter / 100 for
+    ``nodes`` 2048).
 
     ``nodes`` is sized for the default elements; at diameter / 100 (6.25 times the
     quads) even the second try's 4 x 2048 nodes are coarser than the mesh around small
     features: holes a few elements from an edge or from each other got their valence-5
     points on the rim, lines along it, and free faces.  Random plates at diameter / 100
     (bench.plates --seed 7 --d100: four of 40 short of blocks) and the corpus's two logo
-    plates and perforated plate are all blocks at 51200 nodes, in 1.3-11 s (the tries
-    on 2048 nodes, finished, took up to 17 s)."""
-    finest = int(round(nodes * FINER_BACKGROUND * max(1.0, finer_than_default) ** 2))
-    return finest if finest >= 2 * nodes * FINER_BACKGROUND else 0
+    plates and perforated plate are all blocks at 51200 nodes (25600: one of them
+    still short).  At the default size, held-out Prusa MINI y-plate-front f8 is all
+    blocks on 32768 nodes (0.965 on 8192, 41 s in all)."""
+    return int(round(nodes * FINER_BACKGROUND * max(FINER_BACKGROUND,
+                                                    finer_than_default ** 2)))
 
 
-def _best_layout(domain, size, nodes, finest_nodes, method, smoothing, learned_streamlines,
-                 seconds):
+def _best_layout(domain, size, nodes, finer_than_default, method, smoothing,
+                 learned_streamlines, seconds):
     """mesh_domain's layout, on a finer background too where the first leaves free faces."""
     if method != "numerical" or FINER_BACKGROUND <= 1:
         return _mesh_on_background(domain, size, nodes, method, smoothing, learned_streamlines)
@@ -216,7 +216,8 @@ def _best_layout(domain, size, nodes, finest_nodes, method, smoothing, learned_s
     # free faces is not finished (its freeing rounds and unstructured fills cost more
     # than the finer try) unless the finer one leaves more than 1 - GOOD_ENOUGH of its
     # quads out of blocks (nist_ctc04_plate at its default size: 3 s more for 0.905
-    # against the finer layout's 0.975).
+    # against the finer layout's 0.975).  Where the finer one is not all blocks and fair,
+    # a third layout on a background finer still may end the race (_third_layout).
     traced = None
     try:
         result = _mesh_on_background(domain, size, nodes, method, smoothing,
@@ -232,14 +233,16 @@ def _best_layout(domain, size, nodes, finest_nodes, method, smoothing, learned_s
                                              learned_streamlines, traced=traced)
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
-    if finer.structured_share < 1.0 and finest_nodes and (
-            seconds is None or (1.0 + FINER_COST) * (spent + finer.timings["total"]) <= seconds):
-        # Elements finer than the default: a third try, on a background as fine for them
-        # as the second is for the default size (finest_background_nodes).
-        finest = _mesh_on_background(domain, size, finest_nodes, method, smoothing,
-                                     learned_streamlines)
-        finer, other = (finest, finer) if _better(finest, finer) else (finer, finest)
-        _charge(finer, other.timings["total"])
+    if not _whole_and_fair(finer, size):
+        # Before the first is finished (17 s of freeing rounds on a plate at diameter/100
+        # whose third layout took 4 s).
+        finest, cost = _third_layout(domain, size, nodes, finer_than_default, method,
+                                     smoothing, learned_streamlines, seconds, finer,
+                                     spent + finer.timings["total"])
+        if finest is not None:
+            _charge(finest, spent + finer.timings["total"])
+            return finest
+        _charge(finer, cost)
     fair, share = mesh_key(finer.mesh)[:2]
     fair = fair or (share >= 1.0 and fair_but_at_tips(finer.mesh, finer.reference.mesh, size))
     if result is None and fair and share >= GOOD_ENOUGH:  # hardly anything left to beat
@@ -253,6 +256,38 @@ def _best_layout(domain, size, nodes, finest_nodes, method, smoothing, learned_s
     best, other = (finer, result) if _better(finer, result) else (result, finer)
     _charge(best, other.timings["total"])
     return best
+
+
+def _third_layout(domain, size, nodes, finer_than_default, method, smoothing,
+                  learned_streamlines, seconds, second, spent):
+    """Where the second layout is not all blocks and fair: (the layout on a background
+    finer still, finest_background_nodes, if it is all blocks and fair, else None; the
+    seconds it took).  Not tried where it would not fit in ``seconds`` after the
+    ``spent`` ones.  Where the second has more than 1 - GOOD_ENOUGH of its quads out of
+    blocks, all blocks is enough: the rule that a quad under FAIR_JACOBIAN
+    loses to a few unstructured quads is not for a quarter of them (held-out Prusa MINI
+    y-plate-front f8: 75 % in blocks, worst 0.243, against all blocks, worst 0.183, gmsh
+    alg. 11 0.075)."""
+    finest_nodes = finest_background_nodes(nodes, finer_than_default)
+    # Its time, at most about FINER_COST times the second's, whose background, field and
+    # traces grow with the background nodes (the rest with the quads, the same).
+    grows = sum(second.timings.get(k, 0.0) for k in ("background", "field", "tracing"))
+    guess = FINER_COST * (second.timings["total"] - grows
+                          + grows * finest_nodes / (nodes * FINER_BACKGROUND))
+    if seconds is not None and spent + guess > seconds:
+        return None, 0.0
+    finest = _mesh_on_background(domain, size, finest_nodes, method, smoothing,
+                                 learned_streamlines)
+    whole = _whole_and_fair(finest, size) or (
+        finest.structured_share >= 1.0 and second.structured_share < GOOD_ENOUGH
+        and finest.quality["min_scaled_jacobian"] > 0)
+    return (finest if whole else None), finest.timings["total"]
+
+
+def _whole_and_fair(result: MeshResult, size: float) -> bool:
+    """All in blocks with no quad under FAIR_JACOBIAN but at a cusp's tip."""
+    fair, share = mesh_key(result.mesh)[:2]
+    return share >= 1.0 and (fair or fair_but_at_tips(result.mesh, result.reference.mesh, size))
 
 
 def _charge(result: MeshResult, seconds: float) -> None:
