@@ -8,6 +8,7 @@ them without recomputing.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from dataclasses import dataclass, field
 
@@ -122,10 +123,11 @@ def mesh_domain(domain: Domain, size: float | None = None, nodes: int = 2048,
         method = "cnn" if learned_streamlines is not None else "numerical"
     if method == "cnn" and learned_streamlines is None:
         raise ValueError("the cnn method needs a model")
-    size = default_size(domain) if size is None else float(size)
+    default = default_size(domain)
+    size = default if size is None else float(size)
     if not size > 0:
         raise ValueError(f"element size must be positive, got {size}")
-    finer_than_default = default_size(domain) / size
+    finer_than_default = default / size
     # Every copy of the part is meshed in one frame (core.layout_frame) and turned back.
     frame = frame_of(domain)
     framed = framed_domain(domain, frame)
@@ -153,11 +155,18 @@ class _SquaredRescue:
     finishing a worse one on the finer background)."""
 
     def __init__(self, framed, layout, domain, frame, size, nodes, smoothing):
-        squared = squared_holes(framed, size, SQUARED_RESCUE)
-        same = sum(map(is_quartered, squared.loops)) == sum(map(is_quartered, layout.loops))
-        self.layout = None if same else same_frame(squared, framed, domain, frame)
+        self._frames = (framed, layout, domain, frame)
         self.size, self.nodes, self.smoothing = size, nodes, smoothing
         self.outcome = None
+
+    @functools.cached_property
+    def layout(self):
+        """The squared layout, None where no hole is of that size (built only when asked:
+        most parts never need it)."""
+        framed, layout, domain, frame = self._frames
+        squared = squared_holes(framed, self.size, SQUARED_RESCUE)
+        same = sum(map(is_quartered, squared.loops)) == sum(map(is_quartered, layout.loops))
+        return None if same else same_frame(squared, framed, domain, frame)
 
     def available(self) -> bool:
         return self.layout is not None
@@ -260,7 +269,8 @@ def _best_layout(domain, size, nodes, finer_than_default, method, smoothing,
                                              learned_streamlines, traced=traced)
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
-    if not _whole_and_fair(finer, size) and rescue is not None and rescue.available():
+    fair, share = _fair_and_share(finer, size)
+    if not (fair and share >= 1.0) and rescue is not None and rescue.available():
         # The holes squared first: cheaper than the third layout where it does it.
         squared, cost = rescue()
         if squared is not None and _whole_and_fair(squared, size):
@@ -270,7 +280,7 @@ def _best_layout(domain, size, nodes, finer_than_default, method, smoothing,
             return squared
         if squared is None:
             _charge(finer, cost)  # else it is raced at the end (_with_more_holes_squared)
-    if not _whole_and_fair(finer, size):
+    if not (fair and share >= 1.0):
         # Before the first is finished (17 s of freeing rounds on a plate at diameter/100
         # whose third layout took 4 s).
         finest, cost = _third_layout(domain, size, nodes, finer_than_default, method,
@@ -280,8 +290,6 @@ def _best_layout(domain, size, nodes, finer_than_default, method, smoothing,
             _charge(finest, spent + finer.timings["total"])
             return finest
         _charge(finer, cost)
-    fair, share = mesh_key(finer.mesh)[:2]
-    fair = fair or (share >= 1.0 and fair_but_at_tips(finer.mesh, finer.reference.mesh, size))
     if result is None and fair and share >= GOOD_ENOUGH:  # hardly anything left to beat
         _charge(finer, spent)
         return finer
@@ -321,10 +329,18 @@ def _third_layout(domain, size, nodes, finer_than_default, method, smoothing,
     return (finest if whole else None), finest.timings["total"]
 
 
+def _fair_and_share(result: MeshResult, size: float) -> tuple:
+    """(no quad under FAIR_JACOBIAN, or none but at a cusp's tip where all is blocks;
+    the structured share)."""
+    fair, share = mesh_key(result.mesh)[:2]
+    fair = fair or (share >= 1.0 and fair_but_at_tips(result.mesh, result.reference.mesh, size))
+    return fair, share
+
+
 def _whole_and_fair(result: MeshResult, size: float) -> bool:
     """All in blocks with no quad under FAIR_JACOBIAN but at a cusp's tip."""
-    fair, share = mesh_key(result.mesh)[:2]
-    return share >= 1.0 and (fair or fair_but_at_tips(result.mesh, result.reference.mesh, size))
+    fair, share = _fair_and_share(result, size)
+    return fair and share >= 1.0
 
 
 def _charge(result: MeshResult, seconds: float) -> None:
