@@ -214,7 +214,7 @@ def test_a_small_convex_fillet_is_one_corner_at_its_middle():
     assert boundary_features(rounded_rect(100, 60, 1.2 * size), size) == []
 
 
-def test_a_rounded_sharp_tip_is_one_corner_and_a_slots_round_end_stays_a_curve():
+def test_a_rounded_sharp_tip_is_one_corner_and_a_narrow_ribs_round_end_is_two():
     size = 1.0
     # A 40° spike whose tip is a 0.3 fillet (a lettering's stroke end, a gear's tooth).
     r, half = 0.3, math.radians(20)
@@ -229,10 +229,18 @@ def test_a_rounded_sharp_tip_is_one_corner_and_a_slots_round_end_stays_a_curve()
              {"line": [p_high.tolist(), high]}, {"line": [high, low]}]
     tip = boundary_features(domain_from_json({"loops": [spike]}), size)
     assert summary(tip) == [(2, 40.0)]
-    # A slot 0.4 wide ends in a half circle: no corner in it.
-    slot = [{"line": [[0, 0], [10, 0]]}, {"arc": [[10, 0], [10.2, 0.2], [10, 0.4]]},
-            {"line": [[10, 0.4], [0, 0.4]]}, {"line": [[0, 0.4], [0, 0]]}]
-    assert boundary_features(domain_from_json({"loops": [slot]}), size) == []
+    # A rib 0.4 wide ends in a half circle: a square end, two 90° corners a quarter of
+    # the arc from either end; a rib 1.6 wide keeps its half circle as a curve.
+    def rib(width):
+        r = width / 2
+        return domain_from_json({"loops": [[
+            {"line": [[0, 0], [10, 0]]}, {"arc": [[10, 0], [10 + r, r], [10, width]]},
+            {"line": [[10, width], [0, width]]}, {"line": [[0, width], [0, 0]]}]]})
+    end = boundary_features(rib(0.4), size)
+    assert summary(end) == [(0, 90.0), (0, 90.0)]
+    assert sorted(f.pivot_param for f in end) == [0.25, 0.75]
+    assert all(f.pivot_segment == 1 for f in end)
+    assert boundary_features(rib(1.6), size) == []
 
 
 def test_a_lone_concave_fillet_longer_than_max_span_is_still_one_corner():
@@ -453,3 +461,20 @@ def test_a_stretch_holds_its_end_joint_however_the_loop_starts():
     assert _within(at, start, end, total)
     assert _within(start, start, end, total) and _within(start - 1e-15, start, end, total)
     assert not _within(at + 1e-6, start, end, total)
+
+
+@pytest.mark.parametrize("width", [0.3, 0.5, 1.2])
+def test_a_narrow_stroke_with_round_ends_is_one_block_row_with_no_singular_point(width):
+    # A 10 x ``width`` stroke with half-circle ends (a lettering's stroke, a rib) meshed
+    # at size 1: read as curves each end needed two valence-3 points within an element of
+    # each other, and the quads at the ends were squeezed (worst 0.42 at width 0.5).
+    from quadcnn_wb.core.pipeline import mesh_domain
+
+    r = width / 2
+    stroke = domain_from_json({"loops": [[
+        {"line": [[0, 0], [10, 0]]}, {"arc": [[10, 0], [10 + r, r], [10, width]]},
+        {"line": [[10, width], [0, width]]}, {"arc": [[0, width], [-r, r], [0, 0]]}]]})
+    result = mesh_domain(stroke, size=1.0)
+    assert result.structured_share == 1.0
+    assert not result.reference.field.singularities
+    assert result.quality["min_scaled_jacobian"] > 0.9
