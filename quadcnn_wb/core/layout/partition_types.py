@@ -154,13 +154,17 @@ def block_area_share(partition: Partition, domain_area: float) -> float:
 
 
 def inside_polygon(polygon, p) -> bool:
-    """Even-odd rule: p strictly inside the closed polygon (points on it: either way)."""
+    """Even-odd rule: p strictly inside the closed polygon (points on it: either way).
+
+    Over all edges at once, each crossing computed as the loop over them did (a loop
+    took 0.7 ms a call on a 200-point outline, 0.15 s of a small part's partition)."""
     x, y = p
-    inside = False
-    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
+    start = np.asarray(polygon, dtype=float)
+    end = np.roll(start, -1, axis=0)
+    x0, y0, x1, y1 = start[:, 0], start[:, 1], end[:, 0], end[:, 1]
+    crossing = (y0 > y) != (y1 > y)  # y1 != y0 on these
+    x0, y0, x1, y1 = x0[crossing], y0[crossing], x1[crossing], y1[crossing]
+    return bool(np.count_nonzero(x < x0 + (y - y0) * (x1 - x0) / (y1 - y0)) % 2)
 
 
 def fmt(p) -> str:
