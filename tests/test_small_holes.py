@@ -195,7 +195,7 @@ def test_holes_a_little_bigger_are_squared_where_round_ones_leave_free_faces(mon
     domain = load_domain(Path(__file__).parent / "corpus" / "nist_ctc05_flange.brep")
     size = diameter(domain) / 100
     bolt_holes = [2 * loop[0].radius / size for loop in domain.loops[2:]]
-    monkeypatch.setattr(pipeline, "_third_layout", lambda *args: (None, 0.0))
+    monkeypatch.setattr(pipeline, "_third_layout", lambda *args: (None, False))
     assert len(bolt_holes) == 10 and all(SMALL_HOLE < d < SQUARED_RESCUE for d in bolt_holes)
     rescued = mesh_domain(domain, size=size)
     assert rescued.structured_share == 1.0, rescued.problem

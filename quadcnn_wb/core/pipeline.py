@@ -199,12 +199,10 @@ def _with_more_holes_squared(result, rescue, seconds):
     other, cost = rescue()
     if other is None:
         if not tried:
-            result.timings["other_holes"] = cost
-            result.timings["total"] += cost
+            _charge(result, cost, "other_holes")
         return result
     best, worse = (other, result) if _better(other, result) else (result, other)
-    best.timings["other_holes"] = worse.timings["total"]
-    best.timings["total"] += worse.timings["total"]
+    _charge(best, worse.timings["total"], "other_holes")
     return best
 
 
@@ -270,17 +268,17 @@ def _best_layout(domain, size, nodes, finer_than_default, method, smoothing,
     finer = _mesh_on_background(domain, size, nodes * FINER_BACKGROUND, method, smoothing,
                                 learned_streamlines)
     fair, share = _fair_and_share(finer, size)
-    if not (fair and share >= 1.0) and rescue is not None and rescue.available():
+    second_whole = fair and share >= 1.0
+    if not second_whole and rescue is not None and rescue.available():
         # The holes squared first: cheaper than the third layout where it does it.
         squared, cost = rescue()
         if squared is not None and _whole_and_fair(squared, size):
             # The round holes' layouts lost (their time is "other_holes", as after the race).
-            squared.timings["other_holes"] = spent + finer.timings["total"]
-            squared.timings["total"] += spent + finer.timings["total"]
+            _charge(squared, spent + finer.timings["total"], "other_holes")
             return squared
         if squared is None:
             _charge(finer, cost)  # else it is raced at the end (_with_more_holes_squared)
-    if not (fair and share >= 1.0):
+    if not second_whole:
         # Before the first is finished (17 s of freeing rounds on a plate at diameter/100
         # whose third layout took 4 s).
         finest, whole = _third_layout(domain, size, nodes, finer_than_default, method,
@@ -325,10 +323,9 @@ def _third_layout(domain, size, nodes, finer_than_default, method, smoothing,
     whole, it does not: the first, finished, may be all blocks yet (blend_horn_plate at
     its default size: 1.0 against the third's 0.973).  Where the second has more than
     1 - GOOD_ENOUGH of its quads out of blocks, all blocks is enough: the rule that a
-    quad under FAIR_JACOBIAN
-    loses to a few unstructured quads is not for a quarter of them (held-out Prusa MINI
-    y-plate-front f8: 75 % in blocks, worst 0.243, against all blocks, worst 0.183, gmsh
-    alg. 11 0.075)."""
+    quad under FAIR_JACOBIAN loses to a few unstructured quads is not for a quarter of
+    them (held-out Prusa MINI y-plate-front f8: 75 % in blocks, worst 0.243, against all
+    blocks, worst 0.183, gmsh alg. 11 0.075)."""
     finest_nodes = finest_background_nodes(nodes, finer_than_default)
     # Its time, at most about FINER_COST times the second's, whose background, field and
     # traces grow with the background nodes (the rest with the quads, the same).
@@ -359,9 +356,10 @@ def _whole_and_fair(result: MeshResult, size: float) -> bool:
     return fair and share >= 1.0
 
 
-def _charge(result: MeshResult, seconds: float) -> None:
-    """Count the seconds of a layout not kept in the kept one's total."""
-    result.timings["other_background"] = result.timings.get("other_background", 0.0) + seconds
+def _charge(result: MeshResult, seconds: float, key: str = "other_background") -> None:
+    """Count the seconds of a layout not kept in the kept one's total and under ``key``
+    ("other_holes": the layouts with the round holes read otherwise)."""
+    result.timings[key] = result.timings.get(key, 0.0) + seconds
     result.timings["total"] += seconds
 
 

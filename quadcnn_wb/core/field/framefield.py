@@ -165,9 +165,9 @@ def cross_field_solver(mesh: BackgroundMesh):
     interior = np.nonzero(~is_boundary)[0]
     lu = coupling = None
     if len(interior):
-        lap = cotangent_laplacian(mesh.nodes, mesh.triangles)
-        l_ii = lap[interior][:, interior].tocsc()
-        coupling = lap[interior][:, mesh.boundary_nodes]
+        rows = cotangent_laplacian(mesh.nodes, mesh.triangles)[interior]
+        l_ii = rows[:, interior].tocsc()
+        coupling = rows[:, mesh.boundary_nodes]
         lu = splu(l_ii, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
 
     def solve(bz: np.ndarray) -> np.ndarray:

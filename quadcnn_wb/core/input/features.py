@@ -206,14 +206,14 @@ def _loop_features(li, loop, size) -> list:
         return [f for si, arc in enumerate(loop) if getattr(arc, "sweep", 0.0)
                 for f in _end_corners(li, loop, si)]
     features = _chained_features(li, loop, size)
-    return features + _wide_slot_ends(li, loop, features, size)
+    return features + _two_corner_ends(li, loop, features, size)
 
 
 def _is_small_slot(li, loop, size) -> bool:
     """Whether a hole is a slot shorter than SMALL_SLOT sizes end to end: lines and two
     round ends (_round_end, up to WIDE_SLOT_END), every join smooth.  It is read as a
     small round hole is, a rectangle at the mesh's scale (each end two corners, as
-    _wide_slot_ends has them).  Read by the other rules (each narrow end one corner,
+    _two_corner_ends has them).  Read by the other rules (each narrow end one corner,
     chained with the sides when they are short) a slot of one to 1.3 sizes left a loop
     the layout could not reach: a plate with one slot 8 x 2.8 mm at its 6.5 mm default
     size had no block at all (the quads covered the slot).  Longer slots are slits
@@ -272,7 +272,7 @@ def _chained_features(li, loop, size) -> list:
     return out + _chamfers(li, loop, out, size, total, turns)
 
 
-def _wide_slot_ends(li, loop, features, size) -> list:
+def _two_corner_ends(li, loop, features, size) -> list:
     """Two corners (_end_corners) for each wider slot's round end and each narrow rib's
     (see the module docstring): a concave arc of a radius from SLOT_END up to
     WIDE_SLOT_END sizes turning by more than ROUND_SWEEP, up to SLOT_SWEEP, or a convex
